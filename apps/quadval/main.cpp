@@ -1,0 +1,40 @@
+// quadval: quad meshing by recombination, and certified analysis of curved elements.
+//
+//   quadval info mesh.msh
+//   quadval convert mesh.msh mesh.vtu
+#include <cstdio>
+#include <exception>
+
+#include <fmt/core.h>
+
+#include "commands.hpp"
+#include "quadval/error.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"quadval: quad meshing by recombination, and certified bounds on the Jacobian "
+               "and quality of curved finite elements."};
+  app.set_version_flag("--version", std::string("quadval ") + QUADVAL_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough(false);
+
+  int exit_code = quadval::cli::kExitOk;
+  quadval::cli::add_info_command(app, exit_code);
+  quadval::cli::add_convert_command(app, exit_code);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : quadval::cli::kExitBadInput;
+  } catch (const quadval::InputError& e) {
+    fmt::print(stderr, "quadval: error: {}\n", e.what());
+    return quadval::cli::kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "quadval: error: out of memory\n");
+    return quadval::cli::kExitBadInput;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "quadval: internal error: {}\n", e.what());
+    return 3;
+  }
+  return exit_code;
+}

@@ -1,0 +1,2 @@
+list(APPEND QUADVAL_SOURCES
+)

@@ -1,0 +1,5 @@
+list(APPEND QUADVAL_SOURCES
+  src/mesh/element_type.cpp
+  src/mesh/error.cpp
+  src/mesh/mesh.cpp
+)

@@ -1,0 +1,3 @@
+list(APPEND QUADVAL_TEST_SOURCES
+  mesh/element_type_test.cpp
+)
