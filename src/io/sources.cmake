@@ -1,2 +1,3 @@
 list(APPEND QUADVAL_SOURCES
+  src/io/atomic_file.cpp
 )
