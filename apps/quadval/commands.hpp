@@ -12,5 +12,8 @@ inline constexpr int kExitBadInput = 2;
 /// Each add_* registers a subcommand; its callback stores the exit code in `exit_code`.
 void add_info_command(CLI::App& app, int& exit_code);
 void add_convert_command(CLI::App& app, int& exit_code);
+void add_recombine_command(CLI::App& app, int& exit_code);
+void add_mesh_command(CLI::App& app, int& exit_code);
+void add_demo_command(CLI::App& app, int& exit_code);
 
 }  // namespace quadval::cli

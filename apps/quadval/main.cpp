@@ -2,6 +2,8 @@
 //
 //   quadval info mesh.msh
 //   quadval convert mesh.msh mesh.vtu
+//   quadval demo                      (Paper I's rectangle, pictures in ./quadval-demo/rectangle/)
+//   quadval mesh part.step -o part-quads.msh --size 0.5
 #include <cstdio>
 #include <exception>
 
@@ -20,6 +22,9 @@ int main(int argc, char** argv) {
   int exit_code = quadval::cli::kExitOk;
   quadval::cli::add_info_command(app, exit_code);
   quadval::cli::add_convert_command(app, exit_code);
+  quadval::cli::add_recombine_command(app, exit_code);
+  quadval::cli::add_mesh_command(app, exit_code);
+  quadval::cli::add_demo_command(app, exit_code);
 
   try {
     app.parse(argc, argv);

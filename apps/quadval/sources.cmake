@@ -2,4 +2,8 @@ set(QUADVAL_CLI_SOURCES
   apps/quadval/main.cpp
   apps/quadval/info.cpp
   apps/quadval/convert.cpp
+  apps/quadval/recombine.cpp
+  apps/quadval/geometry_pipeline.cpp
+  apps/quadval/mesh.cpp
+  apps/quadval/demo.cpp
 )

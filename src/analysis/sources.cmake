@@ -1,2 +1,6 @@
 list(APPEND QUADVAL_SOURCES
+  src/analysis/jacobian_space.cpp
+  src/analysis/jacobian_samples.cpp
+  src/analysis/jacobian_engine.cpp
+  src/analysis/jacobian_bounds.cpp
 )

@@ -1,2 +1,4 @@
 list(APPEND QUADVAL_SOURCES
+  src/bezier/bernstein_simplex.cpp
+  src/bezier/bezier_basis.cpp
 )

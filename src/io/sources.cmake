@@ -1,3 +1,10 @@
 list(APPEND QUADVAL_SOURCES
   src/io/atomic_file.cpp
+  src/io/file_bytes.cpp
+  src/io/mesh_io.cpp
+  src/io/msh_read.cpp
+  src/io/msh_read_ascii.cpp
+  src/io/msh_read_binary.cpp
+  src/io/msh_write.cpp
+  src/io/surface_read.cpp
 )

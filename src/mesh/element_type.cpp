@@ -206,12 +206,41 @@ const ElementType* find_element_type(int gmsh_id) noexcept {
   return (it != std::end(kTypes) && it->gmsh_id == gmsh_id) ? &*it : nullptr;
 }
 
+namespace {
+
+int family_num_edges(ElementFamily f) noexcept {
+  switch (f) {
+    case ElementFamily::line: return 1;
+    case ElementFamily::triangle: return 3;
+    case ElementFamily::quadrangle: return 4;
+    case ElementFamily::tetrahedron: return 6;
+    case ElementFamily::hexahedron: return 12;
+    case ElementFamily::prism: return 9;
+    case ElementFamily::pyramid: return 8;
+    default: return 0;
+  }
+}
+
+// True when every node is a vertex or an edge node (no face or interior node).
+bool only_vertex_and_edge_nodes(const ElementType& t) noexcept {
+  return t.num_nodes ==
+         family_num_vertices(t.family) + family_num_edges(t.family) * std::max(t.order - 1, 0);
+}
+
+}  // namespace
+
 const ElementType* find_element_type(ElementFamily family, int order, bool complete) noexcept {
+  const ElementType* complete_type = nullptr;
   for (const ElementType& t : kTypes) {
     if (!t.has_lagrange_basis || t.family != family || t.order != order) continue;
-    // Orders 1 (and points) have one type only; it counts as both complete and incomplete.
-    if (t.complete == complete || t.order <= 1) return &t;
+    if (t.complete == complete) return &t;
+    if (t.complete) complete_type = &t;
   }
+  // A complete type without face or interior nodes (points, lines, order 1, order-2
+  // triangles and tetrahedra) is also the incomplete one: Gmsh's
+  // getElementType(family, order, serendip=True) answers the same id.
+  if (!complete && complete_type && only_vertex_and_edge_nodes(*complete_type))
+    return complete_type;
   return nullptr;
 }
 

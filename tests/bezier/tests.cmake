@@ -1,2 +1,3 @@
 list(APPEND QUADVAL_TEST_SOURCES
+  bezier/bezier_basis_test.cpp
 )

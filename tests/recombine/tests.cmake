@@ -1,2 +1,8 @@
 list(APPEND QUADVAL_TEST_SOURCES
+  recombine/quad_quality_test.cpp
+  recombine/blossom_optimality_test.cpp
+  recombine/recombine_test.cpp
+  recombine/repair_test.cpp
+  recombine/recombine_input_test.cpp
+  recombine/recombine_cli_test.cpp
 )

@@ -1,0 +1,214 @@
+// Per-element Jacobian bounds: samples -> first Bézier coefficients -> best-first
+// refinement -> exact fallback (Paper III Algorithms 2-3), and the distortion (eq. 3).
+#include "quadval/jacobian_bounds.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "analysis/jacobian_engine.hpp"
+#include "analysis/jacobian_samples.hpp"
+#include "analysis/jacobian_space.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+double down(double x) { return std::nextafter(x, -kInf); }
+double up(double x) { return std::nextafter(x, kInf); }
+
+// Bézier coefficients of J from samples, and their error bound (see jacobian_bounds.hpp).
+double to_bezier_with_error(const BezierBasis& basis, const double* samples, double err,
+                            double* coeffs, std::vector<double>& scratch) {
+  const auto s = static_cast<std::size_t>(basis.size());
+  scratch.resize(2 * s);
+  basis.to_bezier(samples, coeffs, scratch.data());
+  double max_abs = 0;
+  for (std::size_t k = 0; k < s; ++k) max_abs = std::max(max_abs, std::abs(samples[k]));
+  return up(basis.to_bezier_norm() * (err + basis.to_bezier_rounding() * max_abs) * (1 + 1e-12));
+}
+
+// a / b rounded toward -inf or +inf (b != 0).
+double div_down(double a, double b) { return down(a / b); }
+double div_up(double a, double b) { return up(a / b); }
+
+}  // namespace
+
+const char* validity_name(Validity v) noexcept {
+  switch (v) {
+    case Validity::valid: return "valid";
+    case Validity::invalid: return "invalid";
+    case Validity::undetermined: return "undetermined";
+  }
+  return "?";
+}
+
+BoundsWorkspace::BoundsWorkspace() : impl_(std::make_unique<Impl>()) {}
+BoundsWorkspace::~BoundsWorkspace() = default;
+
+bool jacobian_bounds_supported(const ElementType& type) noexcept {
+  return jacobian_supported(type);
+}
+
+JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* samples,
+                                   double err, const double* nodes, bool planar,
+                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws) {
+  const BezierBasis& basis = space.basis();
+  const auto s = static_cast<std::size_t>(basis.size());
+  JacobianBounds out;
+
+  // Stage 0 (Algorithm 2, lines 3-4): a sample is a value of J.
+  bool sample_invalid = false;
+  for (std::size_t k = 0; k < s; ++k)
+    if (up(samples[k] + err) <= 0) sample_invalid = true;
+
+  // Stage 1: the first Bézier coefficients (eq. 18).
+  ws.coeffs.resize(s);
+  const double err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
+  double sum = 0;
+  for (double c : ws.coeffs) sum += c;
+  out.javg = sum / static_cast<double>(s);
+
+  double scale = 0;
+  for (int v : basis.vertex_indices()) scale = std::max(scale, std::abs(ws.coeffs[static_cast<std::size_t>(v)]));
+  const bool measuring = options.goal == BoundsGoal::measure;
+  const double tol = measuring ? std::max(options.abs_tol, options.rel_tol * scale) : kInf;
+
+  MinRefinement rmin;
+  if (sample_invalid && !measuring) {
+    // Decided already: keep the first coefficients' bounds, no refinement.
+    rmin = refine_minimum(basis, ws.coeffs.data(), err_b, false, kInf, 0, ws);
+  } else {
+    rmin = refine_minimum(basis, ws.coeffs.data(), err_b, true, tol, options.max_subdivisions, ws);
+  }
+  out.jmin_lower = rmin.lower;
+  out.jmin_upper = rmin.upper;
+  out.subdivisions = rmin.subdivisions;
+  out.tolerance_met = !measuring || rmin.upper - rmin.lower <= tol;
+
+  if (measuring) {
+    // max J = -min(-J): negate (exact) and refine the same way.
+    std::vector<double> neg(ws.coeffs.begin(), ws.coeffs.end());
+    for (double& c : neg) c = -c;
+    const MinRefinement rmax =
+        refine_minimum(basis, neg.data(), err_b, false, tol, options.max_subdivisions, ws);
+    out.jmax_lower = -rmax.upper;
+    out.jmax_upper = -rmax.lower;
+    out.subdivisions += rmax.subdivisions;
+    out.tolerance_met = out.tolerance_met && rmax.upper - rmax.lower <= tol;
+  } else {
+    double hi = -kInf, vertex_hi = -kInf;
+    for (double c : ws.coeffs) hi = std::max(hi, c);
+    for (int v : basis.vertex_indices()) vertex_hi = std::max(vertex_hi, ws.coeffs[static_cast<std::size_t>(v)]);
+    out.jmax_upper = up(hi + err_b);
+    out.jmax_lower = down(vertex_hi - err_b);
+  }
+
+  if (sample_invalid) {
+    out.validity = Validity::invalid;
+    out.stage = 0;
+  } else if (out.jmin_lower > 0) {
+    out.validity = Validity::valid;
+  } else if (out.jmin_upper <= 0) {
+    out.validity = Validity::invalid;
+  } else {
+    out.validity = Validity::undetermined;
+  }
+  if (!sample_invalid && out.validity != Validity::undetermined)
+    out.stage = rmin.subdivisions == 0 ? 1 : 1 + rmin.depth;
+
+  if (out.validity == Validity::undetermined && rmin.rounding_limited && options.exact_fallback) {
+    const std::vector<mpq_class> exact_samples = exact_jacobian_samples(space, nodes, planar);
+    const ExactRefinement ex =
+        exact_validity(basis, exact_to_bezier(basis, exact_samples), options.max_subdivisions);
+    out.jmin_lower = std::max(out.jmin_lower, round_down(ex.lower));
+    out.jmin_upper = std::min(out.jmin_upper, round_up(ex.upper));
+    out.validity = ex.validity;
+    out.exact = true;
+    out.subdivisions += ex.subdivisions;
+    if (ex.validity != Validity::undetermined) out.stage = ex.subdivisions == 0 ? 1 : 1 + ex.depth;
+  }
+  return out;
+}
+
+DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,
+                                 const JacobianBounds& jb, BoundsWorkspace::Impl& ws) {
+  const BezierBasis& basis = space.basis();
+  const auto s = static_cast<std::size_t>(basis.size());
+  DistortionBounds d{std::nan(""), std::nan("")};
+  // J_straight: samples of the straight-sided element, then its Bézier coefficients.
+  ws.straight_samples.resize(s);
+  ws.straight_coeffs.resize(s);
+  double err_s = 0;
+  jacobian_samples(space, SampleMap::straight, nodes, 1, planar, ws.straight_samples.data(),
+                   &err_s, ws.sample_scratch);
+  const double err_c = to_bezier_with_error(basis, ws.straight_samples.data(), err_s,
+                                            ws.straight_coeffs.data(), ws.scratch);
+  const auto& c = ws.straight_coeffs;
+  double c_lo = kInf, c_hi = -kInf;
+  for (double x : c) {
+    c_lo = std::min(c_lo, x);
+    c_hi = std::max(c_hi, x);
+  }
+  c_lo = down(c_lo - err_c);
+  c_hi = up(c_hi + err_c);
+  if (!(c_lo > 0)) return d;  // straight element not proven positive: no distortion
+
+  const ElementFamily f = space.type().family;
+  const bool simplex = f == ElementFamily::line || f == ElementFamily::triangle ||
+                       f == ElementFamily::tetrahedron;
+  if (simplex) {
+    // J_straight is constant: in [c_lo, c_hi].
+    d.lower = div_down(jb.jmin_lower, jb.jmin_lower >= 0 ? c_hi : c_lo);
+    d.upper = div_up(jb.jmin_upper, jb.jmin_upper >= 0 ? c_lo : c_hi);
+    return d;
+  }
+  // min J / J_s >= min_i b_i / c_i when every c_i > 0 (J - m J_s has coefficients >= 0).
+  ws.samples.resize(s);
+  double err = 0;
+  jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.samples.data(), &err,
+                   ws.sample_scratch);
+  ws.coeffs.resize(s);
+  const double err_b = to_bezier_with_error(basis, ws.samples.data(), err, ws.coeffs.data(), ws.scratch);
+  double lower = kInf, upper = kInf;
+  for (std::size_t i = 0; i < s; ++i) {
+    const double ci_lo = down(c[i] - err_c), ci_hi = up(c[i] + err_c);
+    if (!(ci_lo > 0)) return d;
+    const double b_lo = down(ws.coeffs[i] - err_b);
+    lower = std::min(lower, div_down(b_lo, b_lo >= 0 ? ci_hi : ci_lo));
+  }
+  for (int v : basis.vertex_indices()) {
+    const auto i = static_cast<std::size_t>(v);
+    const double ci_lo = down(c[i] - err_c), ci_hi = up(c[i] + err_c);
+    const double b_hi = up(ws.coeffs[i] + err_b);
+    upper = std::min(upper, div_up(b_hi, b_hi >= 0 ? ci_lo : ci_hi));
+  }
+  d.lower = lower;
+  d.upper = upper;
+  return d;
+}
+
+JacobianBounds jacobian_bounds(const ElementType& type, std::span<const double> nodes,
+                               const BoundsOptions& options, BoundsWorkspace& workspace,
+                               bool planar) {
+  QV_ASSERT(jacobian_bounds_supported(type), "no Jacobian bounds for " << type.name);
+  QV_ASSERT(nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
+            "nodes " << nodes.size() << " for " << type.name);
+  const JacobianSpace& space = jacobian_space(type);
+  auto& ws = workspace.impl();
+  ws.samples.resize(static_cast<std::size_t>(space.num_samples()));
+  ws.errors.resize(1);
+  jacobian_samples(space, SampleMap::curved, nodes.data(), 1, planar, ws.samples.data(),
+                   ws.errors.data(), ws.sample_scratch);
+  const std::vector<double> samples = ws.samples;
+  return bounds_from_samples(space, samples.data(), ws.errors[0], nodes.data(), planar, options, ws);
+}
+
+DistortionBounds distortion_bounds(const ElementType& type, std::span<const double> nodes,
+                                   const JacobianBounds& jb, BoundsWorkspace& workspace,
+                                   bool planar) {
+  QV_ASSERT(jacobian_bounds_supported(type), "no Jacobian bounds for " << type.name);
+  return distortion_from(jacobian_space(type), nodes.data(), planar, jb, workspace.impl());
+}
+
+}  // namespace quadval

@@ -1,0 +1,248 @@
+// Best-first adaptive subdivision (Paper III §4.2, Algorithm 3), in floating point with a
+// carried error bound per subdomain, and in exact rationals.
+//
+// Bounds per subdomain (eqs. 16-17, 21-22): min J >= min_i b_i (convex hull), and
+// min J <= b_v for every vertex coefficient b_v (a value of J). With |b~ - b| <= err:
+// lower = min b~ - err and upper = min_v b~_v + err, rounded outward.
+// A child of a subdomain has err_child = err + subdivision_rounding * max|b~| (the exact
+// subdivision matrix has nonnegative rows summing to 1, so old errors do not grow).
+#include "analysis/jacobian_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+
+#include "bezier/bezier_exact.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double down(double x) { return std::nextafter(x, -kInf); }
+double up(double x) { return std::nextafter(x, kInf); }
+
+// Min-heap on lower (std heap functions are max-heaps: invert the comparison).
+bool heap_less(const BoundsWorkspace::Impl::Leaf& a, const BoundsWorkspace::Impl::Leaf& b) {
+  return a.lower > b.lower;
+}
+
+// Applies per-factor exact matrices along each axis (see BezierBasis::apply_factors).
+template <class MatrixOf>
+std::vector<mpq_class> apply_exact(const BezierBasis& b, std::vector<mpq_class> in,
+                                   MatrixOf matrix_of) {
+  const auto size = static_cast<std::size_t>(b.size());
+  std::size_t stride = 1;
+  std::vector<mpq_class> out(size);
+  for (std::size_t f = 0; f < b.factors().size(); ++f) {
+    const auto s = static_cast<std::size_t>(b.factors()[f]->size());
+    const std::size_t outer = size / (s * stride);
+    const std::vector<mpq_class>& m = matrix_of(f);
+    for (std::size_t o = 0; o < outer; ++o)
+      for (std::size_t a = 0; a < s; ++a)
+        for (std::size_t i = 0; i < stride; ++i) {
+          mpq_class sum = 0;
+          for (std::size_t j = 0; j < s; ++j) {
+            const mpq_class& w = m[a * s + j];
+            if (sgn(w) != 0) sum += w * in[o * s * stride + j * stride + i];
+          }
+          out[o * s * stride + a * stride + i] = sum;
+        }
+    in.swap(out);
+    stride *= s;
+  }
+  return in;
+}
+
+std::vector<mpq_class> exact_subdivide(const BezierBasis& b, const std::vector<mpq_class>& in,
+                                       int child) {
+  const auto digits = b.child_digits(child);
+  return apply_exact(b, in, [&](std::size_t f) -> const std::vector<mpq_class>& {
+    // one child's block of the factor's subdivision matrices
+    thread_local std::vector<mpq_class> block;
+    const BernsteinSimplex& fac = *b.factors()[f];
+    const auto n = static_cast<std::size_t>(fac.size()) * static_cast<std::size_t>(fac.size());
+    const auto& all = fac.exact().subdivision;
+    block.assign(all.begin() + static_cast<std::ptrdiff_t>(n * static_cast<std::size_t>(digits[f])),
+                 all.begin() + static_cast<std::ptrdiff_t>(n * (static_cast<std::size_t>(digits[f]) + 1)));
+    return block;
+  });
+}
+
+}  // namespace
+
+double round_down(const mpq_class& q) {
+  double d = q.get_d();
+  while (mpq_class(d) > q) d = down(d);
+  while (mpq_class(up(d)) <= q) d = up(d);
+  return d;
+}
+
+double round_up(const mpq_class& q) {
+  double d = q.get_d();
+  while (mpq_class(d) < q) d = up(d);
+  while (mpq_class(down(d)) >= q) d = down(d);
+  return d;
+}
+
+MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, double err,
+                             bool need_sign, double tol, int max_subdivisions,
+                             BoundsWorkspace::Impl& ws) {
+  const auto size = static_cast<std::size_t>(basis.size());
+  const auto vertices = basis.vertex_indices();
+  ws.pool.clear();
+  ws.free_slots.clear();
+  ws.heap.clear();
+  ws.scratch.resize(2 * size);
+
+  MinRefinement r;
+  r.upper = kInf;
+  double floor = kInf;  // min lower bound of subdomains dropped from the heap
+
+  const auto bounds_of = [&](const double* b, double e, double& lower, double& upper,
+                             double& max_abs) {
+    double lo = b[0], hi = kInf, big = 0;
+    for (std::size_t i = 0; i < size; ++i) {
+      lo = std::min(lo, b[i]);
+      big = std::max(big, std::abs(b[i]));
+    }
+    for (int v : vertices) hi = std::min(hi, b[v]);
+    lower = down(lo - e);
+    upper = up(hi + e);
+    max_abs = big;
+  };
+  const auto new_slot = [&]() {
+    if (!ws.free_slots.empty()) {
+      const int s = ws.free_slots.back();
+      ws.free_slots.pop_back();
+      return s;
+    }
+    const int s = static_cast<int>(ws.pool.size() / size);
+    ws.pool.resize(ws.pool.size() + size);
+    return s;
+  };
+  const auto done = [&](double lower) {
+    const bool sign_ok = !need_sign || lower > 0 || r.upper <= 0;
+    return sign_ok && (r.upper - lower <= tol);
+  };
+
+  {
+    double lower, upper, big;
+    bounds_of(coeffs, err, lower, upper, big);
+    r.upper = upper;
+    const int slot = new_slot();
+    std::copy(coeffs, coeffs + size, ws.pool.begin() + static_cast<std::ptrdiff_t>(slot * size));
+    ws.heap.push_back({lower, err, slot, 0});
+  }
+
+  for (;;) {
+    const double lower = std::min(floor, ws.heap.empty() ? kInf : ws.heap.front().lower);
+    r.lower = lower;
+    if (done(lower)) {
+      r.settled = true;
+      break;
+    }
+    if (ws.heap.empty() || r.subdivisions >= max_subdivisions) break;
+    std::pop_heap(ws.heap.begin(), ws.heap.end(), heap_less);
+    const BoundsWorkspace::Impl::Leaf leaf = ws.heap.back();
+    ws.heap.pop_back();
+    ++r.subdivisions;
+
+    const double* parent = ws.pool.data() + static_cast<std::size_t>(leaf.slot) * size;
+    double parent_min = parent[0], parent_max_abs = 0;
+    for (std::size_t i = 0; i < size; ++i) {
+      parent_min = std::min(parent_min, parent[i]);
+      parent_max_abs = std::max(parent_max_abs, std::abs(parent[i]));
+    }
+    if (std::abs(parent_min) <= 8 * leaf.err) r.rounding_limited = true;
+    const double child_err =
+        up((leaf.err + basis.subdivision_rounding() * parent_max_abs) * (1 + 1e-12));
+    for (int q = 0; q < basis.num_children(); ++q) {
+      const int slot = new_slot();
+      // pool may have grown: recompute the parent pointer
+      const double* par = ws.pool.data() + static_cast<std::size_t>(leaf.slot) * size;
+      double* child = ws.pool.data() + static_cast<std::size_t>(slot) * size;
+      basis.subdivide(q, par, child, ws.scratch.data());
+      double lo, hi, big;
+      bounds_of(child, child_err, lo, hi, big);
+      r.upper = std::min(r.upper, hi);
+      r.depth = std::max(r.depth, leaf.depth + 1);
+      const bool proven_positive = need_sign && !std::isfinite(tol) && lo > 0;
+      if (proven_positive || lo >= r.upper - tol) {
+        floor = std::min(floor, lo);
+        ws.free_slots.push_back(slot);
+      } else {
+        ws.heap.push_back({lo, child_err, slot, leaf.depth + 1});
+        std::push_heap(ws.heap.begin(), ws.heap.end(), heap_less);
+      }
+    }
+    ws.free_slots.push_back(leaf.slot);
+  }
+  return r;
+}
+
+std::vector<mpq_class> exact_to_bezier(const BezierBasis& basis, std::vector<mpq_class> samples) {
+  return apply_exact(basis, std::move(samples), [&](std::size_t f) -> const std::vector<mpq_class>& {
+    return basis.factors()[f]->exact().to_bezier;
+  });
+}
+
+ExactRefinement exact_validity(const BezierBasis& basis, std::vector<mpq_class> coeffs,
+                               int max_subdivisions) {
+  struct Node {
+    mpq_class lower;
+    std::vector<mpq_class> c;
+    int depth;
+  };
+  const auto cmp = [](const Node* a, const Node* b) { return a->lower > b->lower; };
+  std::priority_queue<Node*, std::vector<Node*>, decltype(cmp)> heap(cmp);
+  std::vector<std::unique_ptr<Node>> owned;
+  ExactRefinement r;
+  const auto vertices = basis.vertex_indices();
+  bool have_upper = false;
+  mpq_class floor;
+  bool have_floor = false;
+  const auto push = [&](std::vector<mpq_class> c, int depth) {
+    mpq_class lo = *std::min_element(c.begin(), c.end());
+    for (int v : vertices) {
+      if (!have_upper || c[static_cast<std::size_t>(v)] < r.upper) {
+        r.upper = c[static_cast<std::size_t>(v)];
+        have_upper = true;
+      }
+    }
+    if (lo > 0) {  // proven positive here: keep only its bound
+      if (!have_floor || lo < floor) floor = lo;
+      have_floor = true;
+      return;
+    }
+    owned.push_back(std::make_unique<Node>(Node{lo, std::move(c), depth}));
+    heap.push(owned.back().get());
+  };
+  push(std::move(coeffs), 0);
+  for (;;) {
+    if (heap.empty()) {
+      r.lower = floor;
+      r.validity = Validity::valid;
+      return r;
+    }
+    r.lower = heap.top()->lower;
+    if (have_floor && floor < r.lower) r.lower = floor;
+    if (r.upper <= 0) {
+      r.validity = Validity::invalid;
+      return r;
+    }
+    if (r.subdivisions >= max_subdivisions) return r;
+    Node* n = heap.top();
+    heap.pop();
+    ++r.subdivisions;
+    for (int q = 0; q < basis.num_children(); ++q) {
+      r.depth = std::max(r.depth, n->depth + 1);
+      push(exact_subdivide(basis, n->c, q), n->depth + 1);
+    }
+    n->c.clear();
+    n->c.shrink_to_fit();
+  }
+}
+
+}  // namespace quadval

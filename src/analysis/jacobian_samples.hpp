@@ -1,0 +1,46 @@
+#pragma once
+// Samples of the Jacobian determinant at the Lagrange points of its Bézier space, for many
+// elements of one type at once (matrix-matrix products, DESIGN.md "Batching"), each with
+// an a priori bound on its rounding error; and the same in exact rational arithmetic.
+// Thesis, Paper III §4.4 (Algorithm 2, lines 1-2).
+#include <gmpxx.h>
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "analysis/jacobian_space.hpp"
+
+namespace quadval {
+
+/// The reference vector of a 1D or 2D element (jacobian_bounds.hpp): unit tangent
+/// (x1 - x0) of a line; for 2D, +z when planar, else the unit normal of the straight-sided
+/// element. Zero when degenerate. Unused (zero) for 3D elements.
+/// @param nodes #nodes x 3 of one element
+std::array<double, 3> reference_direction(const ElementType& type, const double* nodes,
+                                          bool planar) noexcept;
+
+/// Which gradient matrices to use: the element's own, or its straight-sided element's.
+enum class SampleMap { curved, straight };
+
+/// Scratch of jacobian_samples, reused across calls.
+struct SampleScratch {
+  std::vector<double> coords;  // #nodes x (3 * count), column-major
+  std::vector<double> deriv[3];
+};
+
+/// J at every sample of every element of a batch, and a bound on each element's error.
+/// @param nodes   count x #nodes x 3 coordinates (Gmsh node order)
+/// @param samples out: count x num_samples (element-major)
+/// @param errors  out: count; |computed - exact| <= errors[e] for every sample of e
+/// @param planar  2D: n = +z
+void jacobian_samples(const JacobianSpace& space, SampleMap map, const double* nodes,
+                      std::size_t count, bool planar, double* samples, double* errors,
+                      SampleScratch& scratch);
+
+/// Exact J at every sample of one element, from its double coordinates as exact rationals.
+/// @param nodes #nodes x 3
+std::vector<mpq_class> exact_jacobian_samples(const JacobianSpace& space, const double* nodes,
+                                              bool planar);
+
+}  // namespace quadval

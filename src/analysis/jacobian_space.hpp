@@ -1,0 +1,76 @@
+#pragma once
+// The sampling side of the Jacobian determinant of one element type: the gradients of its
+// Lagrange shape functions at the Lagrange points of the Jacobian's Bézier space, exact
+// (rational) and rounded. Internal to src/analysis.
+//
+// Derivatives are taken in Gmsh's reference coordinates (lagrange_basis.hpp), so J is
+// Gmsh's J: a [-1, 1] direction mapped from the Bézier [0, 1] contributes a factor 1/2 to
+// the gradient (exact in binary). Sample k is at BezierBasis::point(k) (Bézier domain).
+#include <gmpxx.h>
+
+#include <mutex>
+#include <vector>
+
+#include "quadval/bezier_basis.hpp"
+#include "quadval/element_type.hpp"
+
+namespace quadval {
+
+class JacobianSpace {
+ public:
+  /// @pre type.has_lagrange_basis, family in {line, triangle, quadrangle, tetrahedron,
+  ///      prism, hexahedron}, order <= max_supported_order(family)
+  explicit JacobianSpace(const ElementType& type);
+
+  const ElementType& type() const noexcept { return *type_; }
+  const BezierBasis& basis() const noexcept { return *basis_; }
+  int num_nodes() const noexcept { return num_nodes_; }
+  int num_samples() const noexcept { return num_samples_; }
+  int dim() const noexcept { return dim_; }
+  int num_vertices() const noexcept { return num_vertices_; }
+
+  /// dN_i/dxi_c at sample k: gradient(c)[k * num_nodes + i], each entry within
+  /// gradient_rel_error() * |exact| of the exact rational. c < dim().
+  const std::vector<double>& gradient(int c) const noexcept { return grad_[c]; }
+  /// Same for the straight-sided (first-order) element through the vertices:
+  /// straight_gradient(c)[k * num_vertices + v], rounded from the exact rationals.
+  const std::vector<double>& straight_gradient(int c) const noexcept { return straight_[c]; }
+  /// max over samples k and directions c of sum_i |gradient(c)[k, i]| (rounded up, and
+  /// covering the exact entries too).
+  double gradient_row_sum() const noexcept { return gradient_row_sum_; }
+  double gradient_rel_error() const noexcept { return gradient_rel_error_; }
+  /// The same two constants for straight_gradient.
+  double straight_row_sum() const noexcept { return straight_row_sum_; }
+  double straight_rel_error() const noexcept { return straight_rel_error_; }
+
+  /// The exact gradient matrices (same layout), built on first use; thread-safe.
+  const std::vector<mpq_class>& exact_gradient(int c) const;
+
+ private:
+  void build_exact() const;
+
+  const ElementType* type_;
+  const BezierBasis* basis_;
+  int num_nodes_ = 0;
+  int num_samples_ = 0;
+  int dim_ = 0;
+  int num_vertices_ = 0;
+  std::vector<double> grad_[3];
+  std::vector<double> straight_[3];
+  double gradient_row_sum_ = 0;
+  double gradient_rel_error_ = 0;
+  double straight_row_sum_ = 0;
+  double straight_rel_error_ = 0;
+  mutable std::once_flag exact_once_;
+  mutable std::vector<mpq_class> exact_[3];
+};
+
+/// The shared space of `type`; thread-safe, built once.
+/// @pre jacobian_supported(type)
+const JacobianSpace& jacobian_space(const ElementType& type);
+
+/// True when quadval computes Jacobian bounds for this type (all Lagrange types of the
+/// six families, up to max_supported_order; not pyramids).
+bool jacobian_supported(const ElementType& type) noexcept;
+
+}  // namespace quadval

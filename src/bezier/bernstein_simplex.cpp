@@ -1,0 +1,298 @@
+// Bernstein polynomials on a unit simplex: multi-indices, evaluation, the exact
+// Lagrange-to-Bézier matrix and the exact midpoint-subdivision matrices.
+// Thesis, Paper III §4.1-4.3 (eqs. 14, 18-20).
+#include <gmpxx.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <utility>
+
+#include "bezier/bezier_exact.hpp"
+#include "quadval/bezier_basis.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+using MultiIndex = std::array<int, 4>;
+
+// All alpha with |alpha| = n in d+1 components, component 1 varying fastest.
+std::vector<MultiIndex> enumerate_multi_indices(int d, int n) {
+  std::vector<MultiIndex> out;
+  if (d == 1) {
+    for (int i = 0; i <= n; ++i) out.push_back({n - i, i, 0, 0});
+  } else if (d == 2) {
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i + j <= n; ++i) out.push_back({n - i - j, i, j, 0});
+  } else {
+    for (int k = 0; k <= n; ++k)
+      for (int j = 0; j + k <= n; ++j)
+        for (int i = 0; i + j + k <= n; ++i) out.push_back({n - i - j - k, i, j, k});
+  }
+  return out;
+}
+
+mpz_class factorial(int n) {
+  mpz_class f = 1;
+  for (int i = 2; i <= n; ++i) f *= i;
+  return f;
+}
+
+// n! / prod alpha_a!
+mpz_class multinomial(int d, const MultiIndex& a) {
+  int n = 0;
+  for (int c = 0; c <= d; ++c) n += a[static_cast<std::size_t>(c)];
+  mpz_class r = factorial(n);
+  for (int c = 0; c <= d; ++c) r /= factorial(a[static_cast<std::size_t>(c)]);
+  return r;
+}
+
+// Inverse of a square rational matrix by Gauss-Jordan elimination (exact).
+std::vector<mpq_class> invert(std::vector<mpq_class> a, int n) {
+  const auto at = [n](int r, int c) { return static_cast<std::size_t>(r) * n + c; };
+  std::vector<mpq_class> inv(static_cast<std::size_t>(n) * n, mpq_class(0));
+  for (int i = 0; i < n; ++i) inv[at(i, i)] = 1;
+  for (int col = 0; col < n; ++col) {
+    int pivot = col;
+    while (pivot < n && sgn(a[at(pivot, col)]) == 0) ++pivot;
+    QV_ASSERT(pivot < n, "singular Bernstein collocation matrix");
+    if (pivot != col) {
+      for (int c = 0; c < n; ++c) {
+        std::swap(a[at(pivot, c)], a[at(col, c)]);
+        std::swap(inv[at(pivot, c)], inv[at(col, c)]);
+      }
+    }
+    const mpq_class p = a[at(col, col)];
+    for (int c = 0; c < n; ++c) {
+      a[at(col, c)] /= p;
+      inv[at(col, c)] /= p;
+    }
+    for (int r = 0; r < n; ++r) {
+      if (r == col || sgn(a[at(r, col)]) == 0) continue;
+      const mpq_class f = a[at(r, col)];
+      for (int c = 0; c < n; ++c) {
+        if (sgn(a[at(col, c)]) != 0) a[at(r, c)] -= f * a[at(col, c)];
+        if (sgn(inv[at(col, c)]) != 0) inv[at(r, c)] -= f * inv[at(col, c)];
+      }
+    }
+  }
+  return inv;
+}
+
+// Rounds up: the smallest double >= q.
+double round_up(const mpq_class& q) {
+  double d = q.get_d();  // truncates toward zero
+  while (mpq_class(d) < q) d = std::nextafter(d, std::numeric_limits<double>::infinity());
+  return d;
+}
+
+// The double nearest to q (ties either way: the error bound uses u, not u/2).
+double nearest(const mpq_class& q) {
+  const double d = q.get_d();
+  const double up = std::nextafter(d, std::numeric_limits<double>::infinity());
+  const double down = std::nextafter(d, -std::numeric_limits<double>::infinity());
+  double best = d;
+  mpq_class err = abs(mpq_class(d) - q);
+  for (double c : {up, down}) {
+    mpq_class e = abs(mpq_class(c) - q);
+    if (e < err) {
+      err = e;
+      best = c;
+    }
+  }
+  return best;
+}
+
+// Children of the midpoint subdivision, vertices as barycentric coordinates times 2.
+std::vector<std::array<MultiIndex, 4>> midpoint_children(int d) {
+  const auto vertex = [](int a) {
+    MultiIndex v{0, 0, 0, 0};
+    v[static_cast<std::size_t>(a)] = 2;
+    return v;
+  };
+  const auto mid = [](int a, int b) {
+    MultiIndex v{0, 0, 0, 0};
+    v[static_cast<std::size_t>(a)] = 1;
+    v[static_cast<std::size_t>(b)] = 1;
+    return v;
+  };
+  const MultiIndex z{0, 0, 0, 0};
+  if (d == 1) return {{vertex(0), mid(0, 1), z, z}, {mid(0, 1), vertex(1), z, z}};
+  if (d == 2)
+    return {{vertex(0), mid(0, 1), mid(0, 2), z},
+            {mid(0, 1), vertex(1), mid(1, 2), z},
+            {mid(0, 2), mid(1, 2), vertex(2), z},
+            {mid(1, 2), mid(0, 2), mid(0, 1), z}};
+  return {{vertex(0), mid(0, 1), mid(0, 2), mid(0, 3)},
+          {mid(0, 1), vertex(1), mid(1, 2), mid(1, 3)},
+          {mid(0, 2), mid(1, 2), vertex(2), mid(2, 3)},
+          {mid(0, 3), mid(1, 3), mid(2, 3), vertex(3)},
+          // the octahedron, cut along its diagonal m02-m13
+          {mid(0, 2), mid(1, 3), mid(0, 1), mid(1, 2)},
+          {mid(0, 2), mid(1, 3), mid(1, 2), mid(2, 3)},
+          {mid(0, 2), mid(1, 3), mid(2, 3), mid(0, 3)},
+          {mid(0, 2), mid(1, 3), mid(0, 3), mid(0, 1)}};
+}
+
+}  // namespace
+
+BernsteinSimplex::BernsteinSimplex(int dim, int degree)
+    : dim_(dim), degree_(degree), exact_(std::make_unique<Exact>()) {
+  QV_ASSERT(dim >= 1 && dim <= 3 && degree >= 0, "dim " << dim << " degree " << degree);
+  alphas_ = enumerate_multi_indices(dim, degree);
+  const int s = size();
+  QV_ASSERT(s <= 500, "Bernstein factor too large: " << s);
+  const auto n_sz = static_cast<std::size_t>(s);
+  vertex_.assign(n_sz, false);
+  for (int i = 0; i < s; ++i)
+    for (int a = 0; a <= dim; ++a)
+      if (alphas_[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] == degree)
+        vertex_[static_cast<std::size_t>(i)] = true;
+
+  // Collocation matrix V[k][alpha] = B_alpha(point k) (eq. 18); points beta / n.
+  std::vector<mpq_class> v(n_sz * n_sz);
+  const int den = point_denominator();
+  for (int k = 0; k < s; ++k) {
+    const MultiIndex beta = point_numerators(k);
+    for (int i = 0; i < s; ++i) {
+      const MultiIndex& alpha = alphas_[static_cast<std::size_t>(i)];
+      mpq_class b(multinomial(dim, alpha));
+      for (int a = 0; a <= dim; ++a) {
+        mpq_class l(beta[static_cast<std::size_t>(a)], den);
+        l.canonicalize();  // gmpxx does not reduce a num/den pair
+        for (int e = 0; e < alpha[static_cast<std::size_t>(a)]; ++e) b *= l;
+      }
+      v[static_cast<std::size_t>(k) * n_sz + static_cast<std::size_t>(i)] = b;
+    }
+  }
+  exact_->to_bezier = invert(std::move(v), s);
+  to_bezier_.resize(n_sz * n_sz);
+  mpq_class worst_row = 0;
+  for (std::size_t r = 0; r < n_sz; ++r) {
+    mpq_class row = 0;
+    for (std::size_t c = 0; c < n_sz; ++c) {
+      const mpq_class& q = exact_->to_bezier[r * n_sz + c];
+      to_bezier_[r * n_sz + c] = nearest(q);
+      row += abs(q);
+    }
+    if (row > worst_row) worst_row = row;
+  }
+  to_bezier_norm_ = round_up(worst_row);
+
+  // Subdivision (eq. 20) by blossoming: the child's coefficient beta is the blossom of the
+  // parent at (w_0 repeated beta_0 times, ..., w_d repeated beta_d times), i.e. the
+  // coefficient of t^alpha in prod_k (w_k . t)^beta_k times the parent's b_alpha.
+  // With w in halves, the integer numerators sum to 2^n per row.
+  QV_ASSERT(degree <= 60, "degree too high for exact dyadic subdivision: " << degree);
+  children_ = midpoint_children(dim);
+  const int base = degree + 1;
+  const int codes = static_cast<int>(std::pow(base, dim + 1) + 0.5);
+  std::vector<int> index_of(static_cast<std::size_t>(codes), -1);
+  const auto code = [&](const MultiIndex& a) {
+    int c = 0;
+    for (int x = dim; x >= 0; --x) c = c * base + a[static_cast<std::size_t>(x)];
+    return c;
+  };
+  for (int i = 0; i < s; ++i) index_of[static_cast<std::size_t>(code(alphas_[static_cast<std::size_t>(i)]))] = i;
+  const double scale = std::ldexp(1.0, -degree);
+  subdivision_.assign(children_.size() * n_sz * n_sz, 0.0);
+  exact_->subdivision.assign(children_.size() * n_sz * n_sz, mpq_class(0));
+  for (std::size_t q = 0; q < children_.size(); ++q) {
+    for (int r = 0; r < s; ++r) {
+      const MultiIndex& beta = alphas_[static_cast<std::size_t>(r)];
+      // poly: map code -> integer coefficient, for monomials of the current degree
+      std::map<int, mpz_class> poly{{0, mpz_class(1)}};
+      std::map<int, MultiIndex> mono{{0, MultiIndex{0, 0, 0, 0}}};
+      for (int k = 0; k <= dim; ++k) {
+        for (int rep = 0; rep < beta[static_cast<std::size_t>(k)]; ++rep) {
+          std::map<int, mpz_class> next;
+          std::map<int, MultiIndex> next_mono;
+          for (const auto& [c, coef] : poly) {
+            for (int a = 0; a <= dim; ++a) {
+              const int w = children_[q][static_cast<std::size_t>(k)][static_cast<std::size_t>(a)];
+              if (w == 0) continue;
+              MultiIndex m = mono[c];
+              ++m[static_cast<std::size_t>(a)];
+              const int nc = code(m);
+              next[nc] += coef * w;
+              next_mono[nc] = m;
+            }
+          }
+          poly.swap(next);
+          mono.swap(next_mono);
+        }
+      }
+      for (const auto& [c, coef] : poly) {
+        const int col = index_of[static_cast<std::size_t>(c)];
+        QV_ASSERT(col >= 0, "monomial outside the space");
+        QV_ASSERT(coef.fits_ulong_p() && coef.get_ui() < (1ULL << 53), "non-exact entry");
+        const std::size_t at = q * n_sz * n_sz + static_cast<std::size_t>(r) * n_sz +
+                               static_cast<std::size_t>(col);
+        subdivision_[at] = static_cast<double>(coef.get_ui()) * scale;
+        exact_->subdivision[at] = mpq_class(coef, 1) / mpq_class(mpz_class(1) << degree);
+      }
+    }
+  }
+}
+
+BernsteinSimplex::~BernsteinSimplex() = default;
+
+std::array<double, 3> BernsteinSimplex::point(int i) const noexcept {
+  const MultiIndex num = point_numerators(i);
+  const double den = point_denominator();
+  std::array<double, 3> x{0, 0, 0};
+  for (int c = 1; c <= dim_; ++c)
+    x[static_cast<std::size_t>(c - 1)] = num[static_cast<std::size_t>(c)] / den;
+  return x;
+}
+
+std::array<int, 4> BernsteinSimplex::point_numerators(int i) const noexcept {
+  if (degree_ == 0) {
+    MultiIndex b{0, 0, 0, 0};
+    for (int a = 0; a <= dim_; ++a) b[static_cast<std::size_t>(a)] = 1;
+    return b;
+  }
+  return alphas_[static_cast<std::size_t>(i)];
+}
+
+void BernsteinSimplex::evaluate(std::span<const double> xi, std::span<double> values) const {
+  QV_ASSERT(values.size() >= static_cast<std::size_t>(size()), "values too short");
+  std::array<double, 4> lambda{1, 0, 0, 0};
+  for (int c = 1; c <= dim_; ++c) {
+    lambda[static_cast<std::size_t>(c)] = xi[static_cast<std::size_t>(c - 1)];
+    lambda[0] -= lambda[static_cast<std::size_t>(c)];
+  }
+  std::vector<double> fact(static_cast<std::size_t>(degree_) + 1, 1.0);
+  for (int i = 1; i <= degree_; ++i) fact[static_cast<std::size_t>(i)] = fact[static_cast<std::size_t>(i) - 1] * i;
+  for (int i = 0; i < size(); ++i) {
+    const MultiIndex& a = alphas_[static_cast<std::size_t>(i)];
+    double b = fact[static_cast<std::size_t>(degree_)];
+    for (int c = 0; c <= dim_; ++c) {
+      const auto e = static_cast<std::size_t>(a[static_cast<std::size_t>(c)]);
+      b /= fact[e];
+      for (std::size_t k = 0; k < e; ++k) b *= lambda[static_cast<std::size_t>(c)];
+    }
+    values[static_cast<std::size_t>(i)] = b;
+  }
+}
+
+std::span<const double> BernsteinSimplex::subdivision(int child) const noexcept {
+  const auto n = static_cast<std::size_t>(size()) * static_cast<std::size_t>(size());
+  return {subdivision_.data() + static_cast<std::size_t>(child) * n, n};
+}
+
+const BernsteinSimplex& bernstein_simplex(int dim, int degree) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, std::unique_ptr<const BernsteinSimplex>> cache;
+  // One lock across find and insert (STYLE.md §7); building is rare and short.
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{dim, degree}];
+  if (!slot) slot = std::make_unique<const BernsteinSimplex>(dim, degree);
+  return *slot;
+}
+
+}  // namespace quadval

@@ -1,0 +1,178 @@
+// The Bézier basis of the Jacobian space of one (family, order): a tensor product of
+// Bernstein simplex factors, applied factor by factor. Thesis, Paper III §4.3, Table 1.
+#include "quadval/bezier_basis.hpp"
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "quadval/error.hpp"
+
+namespace quadval {
+
+double rounding_gamma(int k) noexcept {
+  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
+  return k * u / (1 - k * u);
+}
+
+std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int p) {
+  switch (family) {
+    case ElementFamily::line: return {{1, p - 1}};
+    case ElementFamily::triangle: return {{2, 2 * (p - 1)}};
+    case ElementFamily::quadrangle: return {{1, 2 * p - 1}, {1, 2 * p - 1}};
+    case ElementFamily::tetrahedron: return {{3, 3 * (p - 1)}};
+    case ElementFamily::prism: return {{2, 3 * p - 2}, {1, 3 * p - 1}};
+    case ElementFamily::hexahedron: return {{1, 3 * p - 1}, {1, 3 * p - 1}, {1, 3 * p - 1}};
+    default: return {};
+  }
+}
+
+int max_supported_order(ElementFamily family) noexcept {
+  switch (family) {
+    case ElementFamily::line:
+    case ElementFamily::triangle:
+    case ElementFamily::quadrangle: return 10;
+    case ElementFamily::tetrahedron:
+    case ElementFamily::prism:
+    case ElementFamily::hexahedron: return 4;
+    default: return 0;
+  }
+}
+
+BezierBasis::BezierBasis(ElementFamily family, int order,
+                         std::vector<const BernsteinSimplex*> factors)
+    : family_(family), order_(order), factors_(std::move(factors)) {
+  QV_ASSERT(!factors_.empty() && factors_.size() <= 3, "1 to 3 factors");
+  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
+  double rounding = 0;
+  double subdivision = 0;
+  for (const BernsteinSimplex* f : factors_) {
+    dim_ += f->dim();
+    size_ *= f->size();
+    num_children_ *= f->num_children();
+    // The product of norms, each step rounded up.
+    to_bezier_norm_ = std::nextafter(to_bezier_norm_ * f->lagrange_to_bezier_norm(),
+                                     std::numeric_limits<double>::infinity());
+    // One pass: entries rounded to nearest (u) and an s-term dot product (gamma_s).
+    rounding += u + rounding_gamma(f->size());
+    subdivision += rounding_gamma(f->size());
+  }
+  // Cross terms between passes are second order: 1% covers them many times over.
+  to_bezier_rounding_ = rounding * 1.01;
+  subdivision_rounding_ = subdivision * 1.01;
+  for (int i = 0; i < size_; ++i) {
+    bool vertex = true;
+    for (std::size_t f = 0; f < factors_.size(); ++f)
+      vertex = vertex && factors_[f]->is_vertex(factor_index(i, static_cast<int>(f)));
+    if (vertex) vertex_indices_.push_back(i);
+  }
+}
+
+int BezierBasis::factor_index(int i, int f) const noexcept {
+  for (int g = 0; g < f; ++g) i /= factors_[static_cast<std::size_t>(g)]->size();
+  return i % factors_[static_cast<std::size_t>(f)]->size();
+}
+
+std::array<double, 3> BezierBasis::point(int i) const noexcept {
+  std::array<double, 3> x{0, 0, 0};
+  std::size_t c = 0;
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    const auto p = factors_[f]->point(factor_index(i, static_cast<int>(f)));
+    for (int k = 0; k < factors_[f]->dim(); ++k) x[c++] = p[static_cast<std::size_t>(k)];
+  }
+  return x;
+}
+
+std::array<int, 3> BezierBasis::child_digits(int child) const noexcept {
+  std::array<int, 3> d{0, 0, 0};
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    d[f] = child % factors_[f]->num_children();
+    child /= factors_[f]->num_children();
+  }
+  return d;
+}
+
+void BezierBasis::evaluate(std::span<const double> x, std::span<double> values) const {
+  QV_ASSERT(values.size() >= static_cast<std::size_t>(size_), "values too short");
+  std::vector<std::vector<double>> fv(factors_.size());
+  std::size_t c = 0;
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    fv[f].resize(static_cast<std::size_t>(factors_[f]->size()));
+    factors_[f]->evaluate(x.subspan(c), fv[f]);
+    c += static_cast<std::size_t>(factors_[f]->dim());
+  }
+  for (int i = 0; i < size_; ++i) {
+    double v = 1;
+    for (std::size_t f = 0; f < factors_.size(); ++f)
+      v *= fv[f][static_cast<std::size_t>(factor_index(i, static_cast<int>(f)))];
+    values[static_cast<std::size_t>(i)] = v;
+  }
+}
+
+// Applies matrix_of(f) (s_f x s_f, row-major) along axis f, for every factor in turn.
+template <class MatrixOf>
+void BezierBasis::apply_factors(const double* in, double* out, double* scratch,
+                                MatrixOf matrix_of) const {
+  const std::size_t nf = factors_.size();
+  std::size_t stride = 1;
+  const double* src = in;
+  for (std::size_t f = 0; f < nf; ++f) {
+    const std::size_t s = static_cast<std::size_t>(factors_[f]->size());
+    const std::size_t outer = static_cast<std::size_t>(size_) / (s * stride);
+    double* dst = (f + 1 == nf) ? out : scratch + (f % 2) * static_cast<std::size_t>(size_);
+    const double* m = matrix_of(f);
+    for (std::size_t o = 0; o < outer; ++o) {
+      const double* sblock = src + o * s * stride;
+      double* dblock = dst + o * s * stride;
+      for (std::size_t a = 0; a < s; ++a) {
+        const double* row = m + a * s;
+        double* d = dblock + a * stride;
+        for (std::size_t i = 0; i < stride; ++i) d[i] = 0;
+        for (std::size_t j = 0; j < s; ++j) {
+          const double w = row[j];
+          if (w == 0) continue;
+          const double* sv = sblock + j * stride;
+          for (std::size_t i = 0; i < stride; ++i) d[i] += w * sv[i];
+        }
+      }
+    }
+    src = dst;
+    stride *= s;
+  }
+}
+
+void BezierBasis::to_bezier(const double* samples, double* coeffs, double* scratch) const {
+  apply_factors(samples, coeffs, scratch,
+                [this](std::size_t f) { return factors_[f]->lagrange_to_bezier().data(); });
+}
+
+void BezierBasis::subdivide(int child, const double* parent, double* out,
+                            double* scratch) const {
+  const std::array<int, 3> digits = child_digits(child);
+  apply_factors(parent, out, scratch, [this, &digits](std::size_t f) {
+    return factors_[f]->subdivision(digits[f]).data();
+  });
+}
+
+const BezierBasis& bezier_basis(ElementFamily family, int order) {
+  if (order < 1 || order > max_supported_order(family))
+    throw std::invalid_argument("no Bézier Jacobian basis for " +
+                                std::string(family_name(family)) + " of order " +
+                                std::to_string(order));
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, std::unique_ptr<const BezierBasis>> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{static_cast<int>(family), order}];
+  if (!slot) {
+    std::vector<const BernsteinSimplex*> factors;
+    for (const FactorDegree& fd : jacobian_factor_degrees(family, order))
+      factors.push_back(&bernstein_simplex(fd.dim, fd.degree));
+    slot = std::make_unique<const BezierBasis>(family, order, std::move(factors));
+  }
+  return *slot;
+}
+
+}  // namespace quadval

@@ -1,0 +1,34 @@
+#pragma once
+// Matchings of the dual graph: optimal (LEMON's weighted perfect matching) and greedy.
+
+#include <cstdint>
+#include <vector>
+
+#include "dual_graph.hpp"
+
+namespace quadval::recombine_detail {
+
+inline constexpr std::uint32_t kUnmatched = 0xffffffffu;
+
+struct Matching {
+  std::vector<std::uint32_t> pairs;  ///< indices into DualGraph::pairs, ascending
+  bool perfect = false;              ///< every triangle is in a pair
+  double cost = 0.0;                 ///< sum of the pair costs
+};
+
+/// Cost -> LEMON weight: w = -round(1e9 * cost), in 64-bit integers (int weights overflow
+/// silently at the extra-edge cost and give a wrong "perfect" matching: measured).
+long long matching_weight(double cost) noexcept;
+
+/// Minimum-cost perfect matching (Paper I §4, eq. 4) by LEMON's MaxWeightedPerfectMatching
+/// on the negated integer weights. If no perfect matching exists, falls back to LEMON's
+/// MaxWeightedMatching with weights 2 (1 + max cost) - cost, which leaves some triangles
+/// unmatched (perfect = false; the number left is small but not proven minimal).
+/// Costs are optimal to within 1e-9 per pair (the weight rounding).
+Matching blossom_matching(const DualGraph& g);
+
+/// Greedy matching of Paper I §3: pairs by increasing cost (ties: lower pair index), taken
+/// when both triangles are still free. Extra pairs are never used.
+Matching greedy_matching(const DualGraph& g);
+
+}  // namespace quadval::recombine_detail

@@ -1,0 +1,243 @@
+// The Blossom-Quad pipeline (Paper I §7) and its baselines: see quadval/recombine.hpp.
+#include "quadval/recombine.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+
+#include <fmt/core.h>
+
+#include "dual_graph.hpp"
+#include "matching.hpp"
+#include "mixed_mesh.hpp"
+#include "quad_cleanup.hpp"
+#include "quadval/error.hpp"
+#include "recombine_stats.hpp"
+#include "refine.hpp"
+#include "repair.hpp"
+#include "smoothing.hpp"
+#include "triangle_input.hpp"
+
+namespace quadval {
+
+namespace {
+
+using namespace recombine_detail;
+using Clock = std::chrono::steady_clock;
+
+class StageTimer {
+ public:
+  StageTimer(RecombineStats& stats, const RecombineOptions& options)
+      : stats_(stats), options_(options), start_(Clock::now()), last_(start_) {}
+  // Ends the current stage: records its time and logs "[stage] message, X ms".
+  void stage(const std::string& name, const std::string& message) {
+    const auto now = Clock::now();
+    const double seconds = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    stats_.times.push_back({name, seconds});
+    if (options_.log) options_.log(fmt::format("[{}] {}, {:.1f} ms", name, message, 1e3 * seconds));
+  }
+  double total() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+ private:
+  RecombineStats& stats_;
+  const RecombineOptions& options_;
+  Clock::time_point start_, last_;
+};
+
+std::array<double, 3> unit_normal(const std::vector<double>& coords,
+                                  const std::array<NodeIndex, 3>& t) {
+  auto n = triangle_normal(coords, t);
+  const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+  return {n[0] / len, n[1] / len, n[2] / len};
+}
+
+// Quads from the matched real pairs; triangles of extra pairs (listed for repair) and of no
+// pair stay triangles.
+MixedMesh mesh_from_matching(const TriangleSurface& s, const DualGraph& g, const Matching& match,
+                             std::vector<ExtraPair>& extra) {
+  MixedMesh m;
+  m.coords = s.coords;
+  m.node_tags = s.node_tags;
+  const std::size_t nt = s.triangles.size();
+  std::vector<std::uint32_t> element_of(nt, kUnmatched);
+  auto add_triangle = [&](std::uint32_t t) {
+    element_of[t] = static_cast<std::uint32_t>(m.elements.size());
+    const auto& v = s.triangles[t];
+    m.elements.push_back({v[0], v[1], v[2], kNoNode});
+    m.region.push_back(s.region[t]);
+    m.normal.push_back(unit_normal(s.coords, v));
+    m.alive.push_back(1);
+  };
+  m.elements.reserve(nt / 2 + 16);
+  for (std::uint32_t i : match.pairs) {
+    const TrianglePair& p = g.pairs[i];
+    if (p.kind == PairKind::extra) {
+      add_triangle(p.t0);
+      add_triangle(p.t1);
+      extra.push_back({element_of[p.t0], element_of[p.t1], p.shared_node});
+      continue;
+    }
+    const auto n0 = unit_normal(s.coords, s.triangles[p.t0]);
+    const auto n1 = unit_normal(s.coords, s.triangles[p.t1]);
+    m.elements.push_back(quad_of_pair(s.triangles[p.t0], p.t0_edge, s.triangles[p.t1]));
+    m.region.push_back(s.region[p.t0]);
+    m.normal.push_back({n0[0] + n1[0], n0[1] + n1[1], n0[2] + n1[2]});
+    m.alive.push_back(1);
+    element_of[p.t0] = element_of[p.t1] = static_cast<std::uint32_t>(m.elements.size() - 1);
+  }
+  for (std::uint32_t t = 0; t < nt; ++t)
+    if (element_of[t] == kUnmatched) add_triangle(t);
+  return m;
+}
+
+void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& options,
+              RecombineStats& stats, StageTimer& timer) {
+  const std::vector<char> fixed = region_boundary_nodes(m);
+  SmoothingOptions smoothing{options.smoothing_passes,
+                             options.size_field ? &options.size_field : nullptr, !s.planar};
+  stats.smoothing_moves += smooth(m, fixed, smoothing);
+  timer.stage("smooth", fmt::format("{} passes, {} moves", options.smoothing_passes,
+                                    stats.smoothing_moves));
+  const CleanupCounts c = cleanup_quads(m, fixed, options.max_cleanup_passes);
+  stats.vertex_merges += c.vertex_merges;
+  stats.doublet_collapses += c.doublet_collapses;
+  timer.stage("cleanup", fmt::format("{} quad-vertex-merges, {} doublet collapses",
+                                     c.vertex_merges, c.doublet_collapses));
+  if (c.vertex_merges + c.doublet_collapses > 0) {
+    const std::size_t moves = smooth(m, fixed, smoothing);
+    stats.smoothing_moves += moves;
+    timer.stage("smooth", fmt::format("{} moves after clean-up", moves));
+  }
+}
+
+Mesh to_mesh(const MixedMesh& m, const Mesh& input, const TriangleSurface& s) {
+  Mesh out;
+  out.entities = input.entities;
+  out.physical_names = input.physical_names;
+  std::vector<NodeIndex> new_index(m.num_nodes(), kNoNode);
+  for (std::size_t e = 0; e < m.elements.size(); ++e) {
+    if (!m.alive[e]) continue;
+    for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i) new_index[m.elements[e][i]] = 0;
+  }
+  for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
+    if (new_index[v] == kNoNode) continue;
+    new_index[v] = static_cast<NodeIndex>(out.node_tags.size());
+    out.node_tags.push_back(m.node_tags[v]);
+    for (int d = 0; d < 3; ++d) out.coords.push_back(m.coords[3 * std::size_t{v} + d]);
+  }
+  // One block per (region, element kind), in region order; element tags 1, 2, ...
+  Tag tag = 1;
+  for (int kind : {4, 3}) {
+    for (std::size_t r = 0; r < s.region_entity.size(); ++r) {
+      ElementBlock b;
+      b.type = find_element_type(kind == 4 ? 3 : 2);
+      b.entity_dim = 2;
+      b.entity_tag = s.region_entity[r];
+      for (std::size_t e = 0; e < m.elements.size(); ++e) {
+        if (!m.alive[e] || m.region[e] != static_cast<std::int32_t>(r) ||
+            MixedMesh::size(m.elements[e]) != kind)
+          continue;
+        b.tags.push_back(tag++);
+        for (int i = 0; i < kind; ++i) b.nodes.push_back(new_index[m.elements[e][i]]);
+      }
+      if (!b.tags.empty()) out.blocks.push_back(std::move(b));
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
+  RecombineResult result;
+  RecombineStats& stats = result.stats;
+  StageTimer timer(stats, options);
+
+  TriangleSurface s = prepare_triangles(input, options.source, result.warnings);
+  stats.input_triangles = s.triangles.size();
+  if (options.cost == PairCostKind::cross_field && !options.cross_field_per_triangle.empty() &&
+      options.cross_field_per_triangle.size() != s.triangles.size())
+    throw InputError::in_file(
+        options.source, fmt::format("the cross field has {} angles for {} triangles",
+                                    options.cross_field_per_triangle.size(), s.triangles.size()));
+  if (options.algorithm == RecombineAlgorithm::blossom &&
+      options.odd_policy == OddPolicy::split_boundary_edge)
+    make_regions_even(s);
+  stats.odd_splits = s.odd_splits;
+  if (s.odd_splits > 0)
+    result.warnings.push_back(fmt::format(
+        "{} surface(s) had an odd number of triangles: no all-quad matching exists, so the "
+        "longest boundary edge of each was split at its midpoint",
+        s.odd_splits));
+  if (!s.odd_regions_left.empty())
+    result.warnings.push_back(fmt::format(
+        "{} surface(s) have an odd number of triangles and no boundary edge to split: at "
+        "least one triangle will remain in each",
+        s.odd_regions_left.size()));
+  timer.stage("input", fmt::format("{} triangles, {} regions", stats.input_triangles,
+                                   s.region_entity.size()));
+
+  // Cross-field angles follow the triangles (split halves inherit their parent's angle).
+  std::vector<double> field;
+  if (!options.cross_field_per_triangle.empty())
+    for (std::uint32_t i : s.input_index) field.push_back(options.cross_field_per_triangle[i]);
+  DualGraphInput gin{&s.coords, &s.triangles, &s.region, s.node_tags.size(), options.cost,
+                     &field, options.cross_field_angle,
+                     options.extra_edges && options.algorithm == RecombineAlgorithm::blossom,
+                     options.extra_edge_cost};
+  const DualGraph graph = build_dual_graph(gin);
+  stats.graph_pairs = graph.num_real;
+  stats.extra_pairs = graph.pairs.size() - graph.num_real;
+  timer.stage("graph", fmt::format("{} pairs, {} extra", stats.graph_pairs, stats.extra_pairs));
+
+  const Matching match = options.algorithm == RecombineAlgorithm::blossom
+                             ? blossom_matching(graph)
+                             : greedy_matching(graph);
+  stats.perfect_matching = match.perfect;
+  stats.matching_cost = match.cost;
+  timer.stage(options.algorithm == RecombineAlgorithm::blossom ? "blossom" : "greedy",
+              fmt::format("{} pairs{}, cost {:.6g}", match.pairs.size(),
+                          match.perfect ? " (perfect)" : " (not perfect)", match.cost));
+  if (!match.perfect && options.algorithm == RecombineAlgorithm::blossom)
+    result.warnings.push_back(fmt::format(
+        "no perfect matching exists even with the extra edges: {} triangle(s) left unmatched",
+        stats.input_triangles + stats.odd_splits - 2 * match.pairs.size()));
+
+  std::vector<ExtraPair> extra;
+  MixedMesh m = mesh_from_matching(s, graph, match, extra);
+  stats.matched_extra_pairs = extra.size();
+  Tag next_tag = 1;
+  for (Tag t : m.node_tags) next_tag = std::max(next_tag, t + 1);
+  const RepairCounts repaired = repair_extra_pairs(m, extra, next_tag);
+  stats.edge_swaps = repaired.edge_swaps;
+  stats.vertex_duplications = repaired.vertex_duplications;
+  if (repaired.failed > 0)
+    result.warnings.push_back(fmt::format(
+        "{} extra-edge pair(s) could not be repaired and stay as triangles", repaired.failed));
+  timer.stage("repair", fmt::format("{} extra pairs matched: {} edge swaps, {} vertex "
+                                    "duplications", extra.size(), repaired.edge_swaps,
+                                    repaired.vertex_duplications));
+
+  if (options.optimize) optimize(m, s, options, stats, timer);
+  if (options.full_quad) {
+    m = refine_to_quads(m, next_tag);
+    timer.stage("refine", fmt::format("{} quads", m.elements.size()));
+    if (options.optimize && options.smoothing_passes > 0) {
+      const std::vector<char> fixed = region_boundary_nodes(m);
+      stats.smoothing_moves += smooth(m, fixed, {options.smoothing_passes,
+                                                 options.size_field ? &options.size_field : nullptr,
+                                                 !s.planar});
+      timer.stage("smooth", "after refinement");
+    }
+  }
+  compute_statistics(m, options.size_field, stats);
+  result.mesh = to_mesh(m, input, s);
+  timer.stage("output", fmt::format("{} quads, {} triangles, eta min {:.3f} mean {:.3f}",
+                                    stats.quads, stats.triangles, stats.eta_min, stats.eta_mean));
+  stats.total_seconds = timer.total();
+  return result;
+}
+
+}  // namespace quadval

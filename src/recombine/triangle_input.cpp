@@ -1,0 +1,236 @@
+#include "triangle_input.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <fmt/core.h>
+
+#include "quadval/error.hpp"
+#include "quadval/topology.hpp"
+
+namespace quadval::recombine_detail {
+
+std::array<double, 3> triangle_normal(const std::vector<double>& coords,
+                                      const std::array<NodeIndex, 3>& t) noexcept {
+  const double* a = &coords[3 * std::size_t{t[0]}];
+  const double* b = &coords[3 * std::size_t{t[1]}];
+  const double* c = &coords[3 * std::size_t{t[2]}];
+  const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+  const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+  return {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+}
+
+namespace {
+
+double squared_distance(const std::vector<double>& x, NodeIndex a, NodeIndex b) {
+  double s = 0;
+  for (int i = 0; i < 3; ++i) {
+    const double d = x[3 * std::size_t{a} + i] - x[3 * std::size_t{b} + i];
+    s += d * d;
+  }
+  return s;
+}
+
+void collect(const Mesh& mesh, const std::string& source, TriangleSurface& s,
+             std::vector<std::string>& warnings) {
+  std::map<int, std::int32_t> region_of_entity;
+  bool high_order = false;
+  for (const ElementBlock& b : mesh.blocks) {
+    QV_ASSERT(b.type != nullptr, "element block without a type");
+    if (b.type->dim <= 1) continue;
+    if (b.type->family != ElementFamily::triangle) {
+      throw InputError::in_element(
+          source, b.tags.empty() ? 0 : b.tags.front(),
+          fmt::format("element is a {} ({}): recombination needs a mesh of triangles only",
+                      family_name(b.type->family), b.type->name));
+    }
+    if (b.type->order > 1) high_order = true;
+    auto [it, inserted] =
+        region_of_entity.emplace(b.entity_tag, static_cast<std::int32_t>(s.region_entity.size()));
+    if (inserted) s.region_entity.push_back(b.entity_tag);
+    for (std::size_t e = 0; e < b.size(); ++e) {
+      const auto n = b.element(e);
+      s.triangles.push_back({n[0], n[1], n[2]});
+      s.region.push_back(it->second);
+      s.triangle_tags.push_back(b.tags[e]);
+      s.input_index.push_back(static_cast<std::uint32_t>(s.input_index.size()));
+    }
+  }
+  if (s.triangles.empty())
+    throw InputError::in_file(source, "no triangles to recombine");
+  if (high_order)
+    warnings.push_back("high-order triangles: only their corner nodes are used");
+}
+
+void check_shapes(const std::string& source, const TriangleSurface& s) {
+  // Zero area: |(b-a)x(c-a)| small against the longest edge squared (collinear corners).
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    const auto& v = s.triangles[t];
+    const auto n = triangle_normal(s.coords, v);
+    const double area2 = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const double longest = std::max({squared_distance(s.coords, v[0], v[1]),
+                                     squared_distance(s.coords, v[1], v[2]),
+                                     squared_distance(s.coords, v[2], v[0])});
+    if (!(area2 > 1e-12 * longest) || longest == 0.0)
+      throw InputError::in_element(
+          source, s.triangle_tags[t],
+          fmt::format("triangle has zero area (nodes {} {} {} are collinear or repeated)",
+                      s.node_tags[v[0]], s.node_tags[v[1]], s.node_tags[v[2]]));
+  }
+  // The same three nodes twice.
+  std::vector<std::pair<std::array<NodeIndex, 3>, std::uint32_t>> keys(s.triangles.size());
+  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
+    auto k = s.triangles[t];
+    std::sort(k.begin(), k.end());
+    keys[t] = {k, static_cast<std::uint32_t>(t)};
+  }
+  std::sort(keys.begin(), keys.end());
+  for (std::size_t i = 1; i < keys.size(); ++i)
+    if (keys[i].first == keys[i - 1].first)
+      throw InputError::in_element(
+          source, s.triangle_tags[std::max(keys[i].second, keys[i - 1].second)],
+          fmt::format("duplicate triangle: same three nodes as element {}",
+                      s.triangle_tags[std::min(keys[i].second, keys[i - 1].second)]));
+}
+
+void check_manifold(const std::string& source, const TriangleSurface& s,
+                    const TriangleTopology& topo) {
+  if (topo.nonmanifold_edges.empty()) return;
+  const std::uint32_t e = topo.nonmanifold_edges.front();
+  std::string tags;
+  for (std::uint32_t i = topo.edge_triangle_offsets[e]; i < topo.edge_triangle_offsets[e + 1]; ++i)
+    tags += (tags.empty() ? "" : " ") + std::to_string(s.triangle_tags[topo.edge_triangles[i]]);
+  throw InputError::in_element(
+      source, s.triangle_tags[topo.edge_triangles[topo.edge_triangle_offsets[e] + 2]],
+      fmt::format("non-manifold edge: nodes {} and {} are shared by {} triangles ({}); "
+                  "recombination needs a manifold surface ({} such edges in all)",
+                  s.node_tags[topo.edges[e][0]], s.node_tags[topo.edges[e][1]],
+                  topo.edge_degree(e), tags, topo.nonmanifold_edges.size()));
+}
+
+// Orients each connected component consistently (breadth first over shared edges), keeping
+// the orientation most of its input triangles have.
+void orient(const std::string& source, TriangleSurface& s, const TriangleTopology& topo) {
+  const std::size_t nt = s.triangles.size();
+  std::vector<signed char> flip(nt, -1);
+  std::vector<std::uint32_t> queue, component;
+  auto runs_forward = [&](std::uint32_t t, NodeIndex a, NodeIndex b) {
+    const auto& v = s.triangles[t];
+    for (int k = 0; k < 3; ++k)
+      if (v[k] == a && v[(k + 1) % 3] == b) return true;
+    return false;
+  };
+  for (std::uint32_t seed = 0; seed < nt; ++seed) {
+    if (flip[seed] >= 0) continue;
+    flip[seed] = 0;
+    queue.assign(1, seed);
+    component.clear();
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const std::uint32_t t = queue[q];
+      component.push_back(t);
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t u = topo.neighbors[t][k];
+        if (u == kNoTriangle) continue;
+        const NodeIndex a = s.triangles[t][k], b = s.triangles[t][(k + 1) % 3];
+        // u must run a->b backwards once both are flipped as decided.
+        const bool same_direction = runs_forward(u, a, b);
+        const signed char want = static_cast<signed char>(flip[t] ^ (same_direction ? 1 : 0));
+        if (flip[u] < 0) {
+          flip[u] = want;
+          queue.push_back(u);
+        } else if (flip[u] != want) {
+          throw InputError::in_element(
+              source, s.triangle_tags[u],
+              "the surface is not orientable (a Moebius-like strip): no consistent quad "
+              "orientation exists");
+        }
+      }
+    }
+    std::size_t flipped = 0;
+    for (std::uint32_t t : component) flipped += static_cast<std::size_t>(flip[t]);
+    const bool invert = 2 * flipped > component.size();
+    for (std::uint32_t t : component) {
+      if ((flip[t] != 0) != invert) {
+        std::swap(s.triangles[t][1], s.triangles[t][2]);
+        ++s.flipped;
+      }
+    }
+  }
+}
+
+}  // namespace
+
+TriangleSurface prepare_triangles(const Mesh& mesh, const std::string& source,
+                                  std::vector<std::string>& warnings) {
+  TriangleSurface s;
+  s.coords = mesh.coords;
+  s.node_tags = mesh.node_tags;
+  collect(mesh, source, s, warnings);
+  check_shapes(source, s);
+  const TriangleTopology topo = build_triangle_topology(s.triangles, s.node_tags.size());
+  check_manifold(source, s, topo);
+  orient(source, s, topo);
+  if (s.flipped > 0)
+    warnings.push_back(fmt::format(
+        "{} triangles were reversed to give each connected surface one orientation", s.flipped));
+  for (std::size_t i = 2; i < s.coords.size(); i += 3)
+    if (s.coords[i] != s.coords[2]) {
+      s.planar = false;
+      break;
+    }
+  return s;
+}
+
+void make_regions_even(TriangleSurface& s) {
+  const std::size_t num_regions = s.region_entity.size();
+  std::vector<std::size_t> count(num_regions, 0);
+  for (std::int32_t r : s.region) ++count[static_cast<std::size_t>(r)];
+  bool any_odd = false;
+  for (std::size_t c : count) any_odd |= (c % 2 == 1);
+  if (!any_odd) return;
+
+  const TriangleTopology topo = build_triangle_topology(s.triangles, s.node_tags.size());
+  // Longest boundary edge per odd region.
+  std::vector<std::uint32_t> best_edge(num_regions, kNoTriangle);
+  std::vector<double> best_length(num_regions, -1.0);
+  for (std::uint32_t e : topo.boundary_edges) {
+    const std::uint32_t t = topo.edge_triangles[topo.edge_triangle_offsets[e]];
+    const auto r = static_cast<std::size_t>(s.region[t]);
+    if (count[r] % 2 == 0) continue;
+    const double len = squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1]);
+    if (len > best_length[r]) {
+      best_length[r] = len;
+      best_edge[r] = e;
+    }
+  }
+  Tag next_tag = 1;
+  for (Tag t : s.node_tags) next_tag = std::max(next_tag, t + 1);
+  for (std::size_t r = 0; r < num_regions; ++r) {
+    if (count[r] % 2 == 0) continue;
+    if (best_edge[r] == kNoTriangle) {
+      s.odd_regions_left.push_back(static_cast<std::int32_t>(r));
+      continue;
+    }
+    const std::uint32_t e = best_edge[r];
+    const std::uint32_t t = topo.edge_triangles[topo.edge_triangle_offsets[e]];
+    const auto m = static_cast<NodeIndex>(s.node_tags.size());
+    for (int i = 0; i < 3; ++i)
+      s.coords.push_back(0.5 * (s.coords[3 * std::size_t{topo.edges[e][0]} + i] +
+                                s.coords[3 * std::size_t{topo.edges[e][1]} + i]));
+    s.node_tags.push_back(next_tag++);
+    const auto v = s.triangles[t];
+    int k = 0;
+    while (topo.triangle_edges[t][k] != e) ++k;
+    // (a, b, c) with the split edge a-b becomes (a, m, c) and (m, b, c): same orientation.
+    const NodeIndex a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
+    s.triangles[t] = {a, m, c};
+    s.triangles.push_back({m, b, c});
+    s.region.push_back(s.region[t]);
+    s.triangle_tags.push_back(s.triangle_tags[t]);
+    s.input_index.push_back(s.input_index[t]);
+    ++s.odd_splits;
+  }
+}
+
+}  // namespace quadval::recombine_detail

@@ -1,0 +1,43 @@
+#pragma once
+// The triangles to recombine, checked and prepared: validated (InputError for bad input),
+// oriented consistently per connected region, and made even per region (OddPolicy).
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "quadval/mesh.hpp"
+#include "quadval/recombine.hpp"
+
+namespace quadval::recombine_detail {
+
+struct TriangleSurface {
+  std::vector<double> coords;                       ///< #nodes × 3 (input nodes, then new ones)
+  std::vector<Tag> node_tags;                       ///< #nodes (new nodes: after the input max)
+  std::vector<std::array<NodeIndex, 3>> triangles;  ///< oriented consistently per component
+  std::vector<std::int32_t> region;                 ///< #triangles: index into region_entity
+  std::vector<Tag> triangle_tags;                   ///< #triangles (split halves share the tag)
+  std::vector<std::uint32_t> input_index;           ///< #triangles: position in triangle_corners()
+  std::vector<int> region_entity;                   ///< entity tag of each region
+  std::size_t flipped = 0;                          ///< triangles reversed to orient consistently
+  std::size_t odd_splits = 0;
+  std::vector<std::int32_t> odd_regions_left;       ///< odd regions that could not be split
+  bool planar = true;                               ///< all nodes at one z
+};
+
+/// Reads the triangles of `mesh`, validates them and orients them (see recombine()'s
+/// @throws). Does not fix parity; see make_regions_even.
+TriangleSurface prepare_triangles(const Mesh& mesh, const std::string& source,
+                                  std::vector<std::string>& warnings);
+
+/// Splits, in each region with an odd triangle count, its longest boundary edge (an edge with
+/// one triangle in the whole mesh) at the midpoint. Regions without such an edge are listed in
+/// odd_regions_left.
+void make_regions_even(TriangleSurface& surface);
+
+/// Signed-area normal (b - a) × (c - a) of a triangle (length = twice its area).
+std::array<double, 3> triangle_normal(const std::vector<double>& coords,
+                                      const std::array<NodeIndex, 3>& t) noexcept;
+
+}  // namespace quadval::recombine_detail

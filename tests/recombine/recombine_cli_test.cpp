@@ -1,0 +1,113 @@
+// `quadval recombine` end to end: exit codes, output file, JSON report.
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "quadval/io.hpp"
+
+namespace quadval {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Run {
+  int code;
+  std::string output;  // stdout and stderr
+};
+
+Run run_cli(const std::string& args) {
+  const fs::path log = fs::temp_directory_path() / ("qv_cli_" + std::to_string(::getpid()) + ".log");
+  const std::string cmd = std::string(QUADVAL_CLI_PATH) + " " + args + " > " + log.string() + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::ifstream in(log);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  fs::remove(log);
+  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, text};
+}
+
+class RecombineCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("qv_recombine_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+TEST_F(RecombineCli, RectSinGivesAllQuadMeshAndReport) {
+  const fs::path in = fs::path(QUADVAL_SHARED_DIR) / "data/tri/rect-sin-a6.msh";
+  if (!fs::exists(in)) GTEST_SKIP() << in << " missing";
+  const fs::path out = dir_ / "q.msh", report = dir_ / "r.json";
+  const Run r = run_cli("recombine " + in.string() + " -o " + out.string() + " --report " +
+                        report.string() + " --size-field '0.1+0.08*sin(3*x)*cos(6*y)'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("[blossom]"), std::string::npos) << r.output;
+  const Mesh q = read_mesh(out);
+  std::size_t quads = 0, others = 0;
+  for (const auto& b : q.blocks) (b.type->gmsh_id == 3 ? quads : others) += b.size();
+  EXPECT_GT(quads, 0u);
+  EXPECT_EQ(others, 0u);
+  std::ifstream f(report);
+  const auto j = nlohmann::json::parse(f);
+  const auto& s = j.at("statistics");
+  EXPECT_EQ(s.at("quads").get<std::size_t>(), quads);
+  EXPECT_EQ(s.at("triangles_left").get<std::size_t>(), 0u);
+  EXPECT_GT(s.at("eta_min").get<double>(), 0.0);
+  EXPECT_FALSE(s.at("tau_percent").is_null());
+  EXPECT_FALSE(s.at("times").empty());
+}
+
+TEST_F(RecombineCli, QuietPrintsNothing) {
+  const fs::path in = fs::path(QUADVAL_SHARED_DIR) / "data/tri/rect-sin-a8.msh";
+  if (!fs::exists(in)) GTEST_SKIP() << in << " missing";
+  const Run r = run_cli("recombine " + in.string() + " -o " + (dir_ / "q.vtu").string() + " -q");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output, "");
+}
+
+TEST_F(RecombineCli, NonManifoldInputExitsTwoWithMessage) {
+  const fs::path in = dir_ / "bad.off";
+  std::ofstream(in) << "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 1 0\n"
+                       "3 0 1 2\n3 1 0 3\n3 0 1 4\n";
+  const Run r = run_cli("recombine " + in.string() + " -o " + (dir_ / "o.msh").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("non-manifold"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir_ / "o.msh"));
+}
+
+TEST_F(RecombineCli, QuadInputAndBadSizeFieldExitTwo) {
+  const fs::path in = dir_ / "quad.off";
+  std::ofstream(in) << "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
+  Run r = run_cli("recombine " + in.string() + " -o " + (dir_ / "o.msh").string());
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("triangles only"), std::string::npos) << r.output;
+  const fs::path tri = dir_ / "tri.off";
+  std::ofstream(tri) << "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+  r = run_cli("recombine " + tri.string() + " -o " + (dir_ / "o.msh").string() +
+              " --size-field 'x+*'");
+  EXPECT_EQ(r.code, 2) << r.output;
+}
+
+TEST_F(RecombineCli, OddTriangleCountIsReportedAndStillAllQuad) {
+  const fs::path in = dir_ / "odd.off";
+  // Three triangles: a fan over the unit square plus one on top.
+  std::ofstream(in) << "OFF\n5 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 1.6 0\n"
+                       "3 0 1 2\n3 0 2 3\n3 3 2 4\n";
+  const fs::path out = dir_ / "o.msh";
+  const Run r = run_cli("recombine " + in.string() + " -o " + out.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("odd number of triangles"), std::string::npos) << r.output;
+  const Mesh q = read_mesh(out);
+  for (const auto& b : q.blocks) EXPECT_EQ(b.type->gmsh_id, 3);
+}
+
+}  // namespace
+}  // namespace quadval

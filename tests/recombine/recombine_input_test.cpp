@@ -1,0 +1,104 @@
+// Bad or unusual input: clear InputError messages, or the documented result.
+#include <gtest/gtest.h>
+
+#include "quadval/error.hpp"
+#include "quadval/recombine.hpp"
+#include "recombine/quad_mesh_checks.hpp"
+#include "recombine/test_meshes.hpp"
+
+namespace quadval {
+namespace {
+
+std::string error_of(const Mesh& m) {
+  RecombineOptions o;
+  o.source = "in.msh";
+  try {
+    recombine(m, o);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RecombineInput, NonManifoldEdgeIsRejected) {
+  const Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}, {0, 1}, {0, -1}, {1, 1}},
+                                          {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}, {2, 1, 4}});
+  const std::string e = error_of(m);
+  EXPECT_NE(e.find("in.msh"), std::string::npos) << e;
+  EXPECT_NE(e.find("non-manifold edge"), std::string::npos) << e;
+  EXPECT_NE(e.find("3 triangles"), std::string::npos) << e;
+}
+
+TEST(RecombineInput, DuplicateTriangleIsRejected) {
+  const Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}, {0, 1}, {1, 1}},
+                                          {{0, 1, 2}, {1, 3, 2}, {2, 0, 1}, {0, 2, 3}});
+  const std::string e = error_of(m);
+  EXPECT_NE(e.find("element 3"), std::string::npos) << e;
+  EXPECT_NE(e.find("duplicate triangle"), std::string::npos) << e;
+}
+
+TEST(RecombineInput, ZeroAreaTriangleIsRejected) {
+  const Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}, {2, 0}, {1, 1}},
+                                          {{0, 1, 3}, {0, 1, 2}});
+  const std::string e = error_of(m);
+  EXPECT_NE(e.find("element 2"), std::string::npos) << e;
+  EXPECT_NE(e.find("zero area"), std::string::npos) << e;
+}
+
+TEST(RecombineInput, QuadMeshIsRejected) {
+  Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}, {1, 1}, {0, 1}}, {});
+  m.blocks[0].type = find_element_type(3);
+  m.blocks[0].tags = {7};
+  m.blocks[0].nodes = {0, 1, 2, 3};
+  const std::string e = error_of(m);
+  EXPECT_NE(e.find("element 7"), std::string::npos) << e;
+  EXPECT_NE(e.find("quadrangle"), std::string::npos) << e;
+  EXPECT_NE(e.find("triangles only"), std::string::npos) << e;
+}
+
+TEST(RecombineInput, NoTrianglesIsRejected) {
+  Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}}, {});
+  m.blocks.clear();
+  EXPECT_NE(error_of(m).find("no triangles"), std::string::npos);
+}
+
+TEST(RecombineInput, InconsistentOrientationIsFixedToTheMajority) {
+  // Three counter-clockwise triangles and one clockwise: the output faces +z.
+  Mesh m = test::random_grid_mesh(2, 1, 4, 0, true, 0.0);
+  auto& nodes = m.blocks[0].nodes;
+  std::swap(nodes[1], nodes[2]);  // reverse the first triangle
+  RecombineOptions o;
+  const RecombineResult r = recombine(m, o);
+  EXPECT_FALSE(r.warnings.empty());
+  for (const auto& b : r.mesh.blocks)
+    for (std::size_t e = 0; e < b.size(); ++e) EXPECT_GT(test::shoelace_area(r.mesh, b.element(e)), 0);
+}
+
+TEST(RecombineInput, OddCountSplitsTheLongestBoundaryEdge) {
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    const Mesh in = test::random_grid_mesh(5, 3, seed, 1, /*make_even=*/false);
+    ASSERT_EQ(in.num_elements() % 2, 1u);
+    const RecombineResult r = recombine(in, {});
+    SCOPED_TRACE(seed);
+    EXPECT_EQ(r.stats.odd_splits, 1u);
+    EXPECT_EQ(r.stats.triangles, 0u);
+    EXPECT_EQ(r.stats.invalid_quads, 0u);
+    EXPECT_FALSE(r.warnings.empty());
+    // One boundary edge is now two: the boundary has one more edge, same total length.
+    const auto before = test::boundary_edges(in), after = test::boundary_edges(r.mesh);
+    EXPECT_EQ(after.size(), before.size() + 1);
+  }
+}
+
+TEST(RecombineInput, OddCountLeavePolicyLeavesOneTriangle) {
+  const Mesh in = test::random_grid_mesh(5, 3, 11, 1, false);
+  RecombineOptions o;
+  o.odd_policy = OddPolicy::leave_triangle;
+  const RecombineResult r = recombine(in, o);
+  EXPECT_FALSE(r.stats.perfect_matching);
+  EXPECT_GE(r.stats.triangles, 1u);
+  test::expect_valid_recombination(in, r.mesh);
+}
+
+}  // namespace
+}  // namespace quadval
