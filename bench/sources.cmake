@@ -1,2 +1,4 @@
 list(APPEND QUADVAL_BENCH_SOURCES
+  recombine_bench.cpp
+  io_bench.cpp
 )

@@ -15,5 +15,6 @@ void add_convert_command(CLI::App& app, int& exit_code);
 void add_recombine_command(CLI::App& app, int& exit_code);
 void add_mesh_command(CLI::App& app, int& exit_code);
 void add_demo_command(CLI::App& app, int& exit_code);
+void add_check_command(CLI::App& app, int& exit_code);
 
 }  // namespace quadval::cli

@@ -84,6 +84,7 @@ int run(const DemoCliOptions& o) {
   PipelineSettings settings;
   settings.title = fmt::format("quadval demo {}: {}", demo->name, demo->description);
   settings.source = domain.source;
+  settings.picture_label = std::string("demo ") + demo->name;
   settings.recombine = o.recombine;
   settings.size = t.size;
   settings.quiet = o.quiet;

@@ -17,6 +17,7 @@ namespace quadval::cli {
 struct PipelineSettings {
   std::string title;                    ///< first line of the table, e.g. the demo's name
   std::string source;                   ///< input name for messages
+  std::string picture_label;            ///< short name in picture titles (default: source)
   std::string recombine = "blossom";    ///< blossom | greedy | lookahead | none
   std::optional<SizeField> size;        ///< gives tau and the l^h histogram when set
   bool quiet = false;                   ///< no stage log, no table

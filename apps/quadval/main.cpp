@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   quadval::cli::add_recombine_command(app, exit_code);
   quadval::cli::add_mesh_command(app, exit_code);
   quadval::cli::add_demo_command(app, exit_code);
+  quadval::cli::add_check_command(app, exit_code);
 
   try {
     app.parse(argc, argv);

@@ -64,6 +64,7 @@ int run(const MeshCliOptions& o) {
     tri = triangulate_geometry_file(geometry, t);
     settings.source = o.geometry;
   }
+  settings.picture_label = o.domain.empty() ? geometry.filename().string() : "planar domain";
   settings.recombine = o.recombine;
   settings.size = t.size;
   settings.quiet = o.quiet;

@@ -6,4 +6,5 @@ set(QUADVAL_CLI_SOURCES
   apps/quadval/geometry_pipeline.cpp
   apps/quadval/mesh.cpp
   apps/quadval/demo.cpp
+  apps/quadval/check.cpp
 )

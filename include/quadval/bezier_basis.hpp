@@ -109,9 +109,11 @@ struct FactorDegree {
 };
 std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int order);
 
-/// Highest geometric order whose Jacobian space we build, per family: every order Gmsh
-/// defines in 2D and for lines, 4 for tetrahedra and prisms, 4 for hexahedra. 0 for
-/// families not handled (pyramids, polygons...).
+/// Highest geometric order whose Jacobian space we build, per family: lines 10 (every
+/// order Gmsh defines), triangles and quadrangles 6, tetrahedra 4, prisms and
+/// hexahedra 3. The limit is the conditioning of the equispaced Lagrange-to-Bézier
+/// conversion in double precision (see bezier_basis.cpp), not memory. 0 for families not
+/// handled (pyramids, polygons...).
 int max_supported_order(ElementFamily family) noexcept;
 
 /// The Bézier basis of the Jacobian determinant space of (family, order p): a tensor

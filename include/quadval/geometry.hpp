@@ -62,6 +62,9 @@ struct CurveNodes {
 struct SurfaceTriangles {
   int surface = 0;              ///< Gmsh surface tag
   std::size_t triangles = 0;
+  /// All its nodes lie in one plane (to 1e-9 of its size): smoothing inside it keeps nodes on
+  /// the geometry; on a curved face it would not.
+  bool planar = true;
   bool even() const noexcept { return triangles % 2 == 0; }
 };
 
@@ -75,6 +78,9 @@ struct Triangulation {
   std::size_t num_triangles = 0;
   std::size_t num_volumes_skipped = 0;   ///< volumes in the model (only their surfaces are meshed)
   double seconds = 0.0;                  ///< wall time inside Gmsh (load + mesh + read back)
+  /// What did not go as asked, e.g. Frontal-Delaunay for quads failed on a periodic CAD face
+  /// (Gmsh 4.8.4) and the surfaces were meshed with Frontal-Delaunay instead.
+  std::vector<std::string> warnings;
 
   std::size_t num_odd_curves() const noexcept {
     std::size_t n = 0;
@@ -82,6 +88,11 @@ struct Triangulation {
     return n;
   }
   bool all_curves_odd() const noexcept { return num_odd_curves() == curves.size(); }
+  bool all_surfaces_planar() const noexcept {
+    for (const SurfaceTriangles& s : surfaces)
+      if (!s.planar) return false;
+    return true;
+  }
 };
 
 /// Meshes the surfaces of a geometry file with triangles.

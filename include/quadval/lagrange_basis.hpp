@@ -10,7 +10,10 @@
 ///   hexahedron  [-1, 1]^3
 ///   prism       triangle (u, v) × w in [-1, 1]
 ///   pyramid     base [-1, 1]^2 at w = 0, apex (0, 0, 1); Bergot's rational space
-///               (thesis, Paper IV eqs. 1-2)
+///               (thesis, Paper IV eqs. 1-2, lines 1502-1540 of the text), written in
+///               xi' = xi/(1-zeta), eta' = eta/(1-zeta) in [-1, 1]: an affine change of the
+///               thesis' xi/(1-zeta) in [0, 1], so the same space. Gmsh 4.8.4's complete
+///               pyramids use this space too (its values agree with ours to 1e-11, orders 1-9).
 /// Unused coordinates are 0.
 ///
 /// Node order is Gmsh's: vertices, then the nodes inside each edge (running from the

@@ -64,14 +64,33 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
 
   // Stage 1: the first Bézier coefficients (eq. 18).
   ws.coeffs.resize(s);
-  const double err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
+  double err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
+  const bool measuring = options.goal == BoundsGoal::measure;
+  if (measuring || !sample_invalid) {
+    double lo = kInf;
+    for (double c : ws.coeffs) lo = std::min(lo, c);
+    if (measuring || !(down(lo - err_b) > 0)) {
+      // Not settled by the cheap per-element error bound: redo this element with the
+      // per-sample bound (jacobian_samples.cpp), much sharper, before refining.
+      ws.tight_samples.resize(s);
+      double tight_err = 0;
+      jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.tight_samples.data(),
+                       &tight_err, ws.sample_scratch, /*tight=*/true);
+      ws.tight_coeffs.resize(s);
+      const double tight_b = to_bezier_with_error(basis, ws.tight_samples.data(), tight_err,
+                                                  ws.tight_coeffs.data(), ws.scratch);
+      if (tight_b < err_b) {
+        err_b = tight_b;
+        ws.coeffs = ws.tight_coeffs;
+      }
+    }
+  }
   double sum = 0;
   for (double c : ws.coeffs) sum += c;
   out.javg = sum / static_cast<double>(s);
 
   double scale = 0;
   for (int v : basis.vertex_indices()) scale = std::max(scale, std::abs(ws.coeffs[static_cast<std::size_t>(v)]));
-  const bool measuring = options.goal == BoundsGoal::measure;
   const double tol = measuring ? std::max(options.abs_tol, options.rel_tol * scale) : kInf;
 
   MinRefinement rmin;
@@ -83,6 +102,8 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
   }
   out.jmin_lower = rmin.lower;
   out.jmin_upper = rmin.upper;
+  // Every sample is a value of J, so the smallest is an upper bound of min J too.
+  for (std::size_t k = 0; k < s; ++k) out.jmin_upper = std::min(out.jmin_upper, up(samples[k] + err));
   out.subdivisions = rmin.subdivisions;
   out.tolerance_met = !measuring || rmin.upper - rmin.lower <= tol;
 
@@ -141,7 +162,7 @@ DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes
   ws.straight_coeffs.resize(s);
   double err_s = 0;
   jacobian_samples(space, SampleMap::straight, nodes, 1, planar, ws.straight_samples.data(),
-                   &err_s, ws.sample_scratch);
+                   &err_s, ws.sample_scratch, /*tight=*/true);
   const double err_c = to_bezier_with_error(basis, ws.straight_samples.data(), err_s,
                                             ws.straight_coeffs.data(), ws.scratch);
   const auto& c = ws.straight_coeffs;
@@ -167,7 +188,7 @@ DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes
   ws.samples.resize(s);
   double err = 0;
   jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.samples.data(), &err,
-                   ws.sample_scratch);
+                   ws.sample_scratch, /*tight=*/true);
   ws.coeffs.resize(s);
   const double err_b = to_bezier_with_error(basis, ws.samples.data(), err, ws.coeffs.data(), ws.scratch);
   double lower = kInf, upper = kInf;

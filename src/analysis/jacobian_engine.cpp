@@ -168,8 +168,12 @@ MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, dou
       bounds_of(child, child_err, lo, hi, big);
       r.upper = std::min(r.upper, hi);
       r.depth = std::max(r.depth, leaf.depth + 1);
+      // Dropped: proven positive while settling the sign, or unable to lower the
+      // minimum by more than the tolerance. Either way its lower bound is kept in floor.
       const bool proven_positive = need_sign && !std::isfinite(tol) && lo > 0;
-      if (proven_positive || lo >= r.upper - tol) {
+      const bool within_tol = std::isfinite(tol) && lo >= r.upper - tol &&
+                              (!need_sign || lo > 0 || r.upper <= 0);
+      if (proven_positive || within_tol) {
         floor = std::min(floor, lo);
         ws.free_slots.push_back(slot);
       } else {

@@ -23,6 +23,7 @@ struct BoundsWorkspace::Impl {
   };
   SampleScratch sample_scratch;
   std::vector<double> samples, errors, coeffs, scratch, straight_samples, straight_coeffs;
+  std::vector<double> tight_samples, tight_coeffs;
   std::vector<double> pool;
   std::vector<int> free_slots;
   std::vector<Leaf> heap;

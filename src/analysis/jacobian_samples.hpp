@@ -34,9 +34,12 @@ struct SampleScratch {
 /// @param samples out: count x num_samples (element-major)
 /// @param errors  out: count; |computed - exact| <= errors[e] for every sample of e
 /// @param planar  2D: n = +z
+/// @param tight   bound each sample from its own derivative magnitudes (about 3x the
+///                work of the samples, far sharper for elements much smaller than
+///                (Gamma R)^dim); else one cheap bound per element from Gamma R
 void jacobian_samples(const JacobianSpace& space, SampleMap map, const double* nodes,
                       std::size_t count, bool planar, double* samples, double* errors,
-                      SampleScratch& scratch);
+                      SampleScratch& scratch, bool tight = false);
 
 /// Exact J at every sample of one element, from its double coordinates as exact rationals.
 /// @param nodes #nodes x 3

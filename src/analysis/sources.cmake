@@ -3,4 +3,6 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/jacobian_samples.cpp
   src/analysis/jacobian_engine.cpp
   src/analysis/jacobian_bounds.cpp
+  src/analysis/check_mesh.cpp
+  src/analysis/check_report.cpp
 )

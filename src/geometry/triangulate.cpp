@@ -88,8 +88,12 @@ void run_gmsh_step(geometry::GmshSession& session, const std::string& source, co
   }
   std::vector<std::string> errors = session.take_errors();
   if (!thrown.empty()) errors.push_back(thrown);
-  if (!errors.empty())
-    throw InputError::in_file(source, fmt::format("Gmsh failed {}: {}", what, join(errors, "; ")));
+  if (errors.empty()) return;
+  // Gmsh may repeat one error for every point it tries: show the first three.
+  const std::size_t more = errors.size() > 3 ? errors.size() - 3 : 0;
+  errors.resize(errors.size() - more);
+  if (more) errors.push_back(fmt::format("and {} more", more));
+  throw InputError::in_file(source, fmt::format("Gmsh failed {}: {}", what, join(errors, "; ")));
 }
 
 // The first point where the size callback met a non-positive h (Gmsh cannot be told "stop"
@@ -99,6 +103,44 @@ struct SizeFailure {
   bool failed = false;
   double h = 0, x = 0, y = 0, z = 0;
 };
+
+// All nodes of the block within 1e-9 × its bounding-box diagonal of the plane through their
+// centroid, normal to the sum of the triangles' area vectors.
+bool is_planar(const Mesh& mesh, const ElementBlock& block) {
+  std::array<double, 3> normal{0, 0, 0}, centroid{0, 0, 0}, lo{HUGE_VAL, HUGE_VAL, HUGE_VAL},
+      hi{-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+  std::size_t count = 0;
+  for (std::size_t e = 0; e < block.size(); ++e) {
+    const auto n = block.element(e);
+    const auto a = mesh.node(n[0]), b = mesh.node(n[1]), c = mesh.node(n[2]);
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double v[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    normal[0] += u[1] * v[2] - u[2] * v[1];
+    normal[1] += u[2] * v[0] - u[0] * v[2];
+    normal[2] += u[0] * v[1] - u[1] * v[0];
+    for (int k = 0; k < 3; ++k) {
+      const auto p = mesh.node(n[k]);
+      for (int d = 0; d < 3; ++d) {
+        centroid[d] += p[d];
+        lo[d] = std::min(lo[d], p[d]);
+        hi[d] = std::max(hi[d], p[d]);
+      }
+      ++count;
+    }
+  }
+  const double len = std::hypot(normal[0], normal[1], normal[2]);
+  if (count == 0 || len == 0) return false;  // a closed surface has a zero area vector
+  const double diag = std::hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  for (double& c : centroid) c /= static_cast<double>(count);
+  for (std::size_t e = 0; e < block.size(); ++e)
+    for (const NodeIndex n : block.element(e)) {
+      const auto p = mesh.node(n);
+      const double d = ((p[0] - centroid[0]) * normal[0] + (p[1] - centroid[1]) * normal[1] +
+                        (p[2] - centroid[2]) * normal[2]) / len;
+      if (std::abs(d) > 1e-9 * diag) return false;
+    }
+  return true;
+}
 
 // Sizes, algorithm, parity-right curves, then surfaces; read back and check.
 Triangulation mesh_current_model(geometry::GmshSession& session, const std::string& source,
@@ -155,13 +197,31 @@ Triangulation mesh_current_model(geometry::GmshSession& session, const std::stri
 
   // Paper I eqs. (5)-(6): odd interior node counts on every curve make the triangle count of
   // a planar face even. Gmsh chooses such counts when recombination is on during the 1D step.
-  if (options.odd_curve_nodes) {
-    gmsh::option::setNumber("Mesh.RecombineAll", 1);
-    gmsh::option::setNumber("Mesh.RecombinationAlgorithm", 1);
+  auto mesh_curves_then_surfaces = [&] {
+    if (options.odd_curve_nodes) {
+      gmsh::option::setNumber("Mesh.RecombineAll", 1);
+      gmsh::option::setNumber("Mesh.RecombinationAlgorithm", 1);
+    }
+    run_gmsh_step(session, source, "to mesh the curves", [] { gmsh::model::mesh::generate(1); });
+    gmsh::option::setNumber("Mesh.RecombineAll", 0);
+    run_gmsh_step(session, source, "to mesh the surfaces", [] { gmsh::model::mesh::generate(2); });
+  };
+  std::vector<std::string> warnings;
+  try {
+    mesh_curves_then_surfaces();
+  } catch (const InputError& e) {
+    if (options.algorithm != TriangleAlgorithm::frontal_quad || failure.failed) throw;
+    // Frontal-Delaunay for quads needs a cross field on a background mesh, in which Gmsh 4.8.4
+    // cannot locate points near the seam of a periodic CAD face (a cylinder's): such models
+    // are meshed again with Frontal-Delaunay, which needs no cross field.
+    warnings.push_back(fmt::format("Frontal-Delaunay for quads failed, so the surfaces were "
+                                   "meshed with Frontal-Delaunay instead ({})",
+                                   e.message()));
+    gmsh::model::mesh::clear();
+    (void)session.take_errors();
+    gmsh::option::setNumber("Mesh.Algorithm", gmsh_algorithm_id(TriangleAlgorithm::frontal));
+    mesh_curves_then_surfaces();
   }
-  run_gmsh_step(session, source, "to mesh the curves", [] { gmsh::model::mesh::generate(1); });
-  gmsh::option::setNumber("Mesh.RecombineAll", 0);
-  run_gmsh_step(session, source, "to mesh the surfaces", [] { gmsh::model::mesh::generate(2); });
   if (failure.failed)
     throw InputError::in_file(
         fmt::format("size expression '{}'", options.size->expression()),
@@ -170,6 +230,7 @@ Triangulation mesh_current_model(geometry::GmshSession& session, const std::stri
                     failure.h, failure.x, failure.y, failure.z));
 
   Triangulation out;
+  out.warnings = std::move(warnings);
   out.mesh = geometry::read_gmsh_model_mesh(2);
   out.num_volumes_skipped = count[3];
   for (const ElementBlock& block : out.mesh.blocks) {
@@ -180,7 +241,7 @@ Triangulation mesh_current_model(geometry::GmshSession& session, const std::stri
       out.curves.push_back({block.entity_tag, tags.size()});
     }
     if (block.entity_dim == 2 && block.type->family == ElementFamily::triangle) {
-      out.surfaces.push_back({block.entity_tag, block.size()});
+      out.surfaces.push_back({block.entity_tag, block.size(), is_planar(out.mesh, block)});
       out.num_triangles += block.size();
     }
   }

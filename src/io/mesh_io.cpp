@@ -10,6 +10,7 @@
 #include "io/msh_reader.hpp"
 #include "io/msh_write.hpp"
 #include "io/surface_read.hpp"
+#include "io/vtu_write.hpp"
 #include "quadval/atomic_file.hpp"
 #include "quadval/error.hpp"
 #include "quadval/io.hpp"
@@ -64,6 +65,9 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const Write
       write_file_atomically(path, [&](std::ostream& out) {
         io::write_msh(mesh, out, options.format == MeshFormat::msh41, options.binary, fields, name);
       });
+      return;
+    case MeshFormat::vtu:
+      write_file_atomically(path, [&](std::ostream& out) { io::write_vtu(mesh, out, fields, name); });
       return;
     default:
       throw InputError::in_file(name, "STL, OBJ and OFF are input formats only; write .msh or .vtu");

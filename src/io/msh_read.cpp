@@ -180,7 +180,13 @@ void finish_msh22(MshReadState& state, bool binary) {
   TagIndex first_with_tag(n);
   bool warned_no_entity = false;
 
+  // Consecutive elements nearly always share type and entity: remember the last lookups.
+  std::uint64_t last_entity_key = ~0ull, last_block_key = ~0ull;
+  std::size_t last_block = 0;
+  int last_physical = 0;
   auto add_physical = [&](const ElementType& type, int elementary, int physical) {
+    const std::uint64_t key = pack(type.dim, elementary);
+    if (key == last_entity_key && physical == last_physical) return;
     if (elementary == 0) {
       if (physical != 0 && !warned_no_entity) {
         warned_no_entity = true;
@@ -197,6 +203,8 @@ void finish_msh22(MshReadState& state, bool binary) {
     }
     std::vector<int>& tags = mesh.entities[it->second].physical_tags;
     if (physical != 0 && std::find(tags.begin(), tags.end(), physical) == tags.end()) tags.push_back(physical);
+    last_entity_key = key;
+    last_physical = physical;
   };
 
   for (std::size_t i = 0; i < n; ++i) {
@@ -211,20 +219,25 @@ void finish_msh22(MshReadState& state, bool binary) {
       continue;
     }
     first_with_tag.insert(el.tag, static_cast<std::uint32_t>(i));
-    auto [it, added] = block_of.try_emplace(pack(el.type->gmsh_id, el.elementary), mesh.blocks.size());
-    if (added) {
-      ElementBlock block;
-      block.type = el.type;
-      block.entity_dim = el.type->dim;
-      block.entity_tag = el.elementary;
-      mesh.blocks.push_back(std::move(block));
-      physicals_in_block.emplace_back();
+    const std::uint64_t block_key = pack(el.type->gmsh_id, el.elementary);
+    if (block_key != last_block_key) {
+      auto [it, added] = block_of.try_emplace(block_key, mesh.blocks.size());
+      if (added) {
+        ElementBlock block;
+        block.type = el.type;
+        block.entity_dim = el.type->dim;
+        block.entity_tag = el.elementary;
+        mesh.blocks.push_back(std::move(block));
+        physicals_in_block.emplace_back();
+      }
+      last_block_key = block_key;
+      last_block = it->second;
     }
-    ElementBlock& block = mesh.blocks[it->second];
+    ElementBlock& block = mesh.blocks[last_block];
     block.tags.push_back(el.tag);
     const auto nodes = nodes_of(i);
     block.nodes.insert(block.nodes.end(), nodes.begin(), nodes.end());
-    physicals_in_block[it->second].push_back(el.physical);
+    physicals_in_block[last_block].push_back(el.physical);
     add_physical(*el.type, el.elementary, el.physical);
   }
 

@@ -7,4 +7,9 @@ list(APPEND QUADVAL_SOURCES
   src/io/msh_read_binary.cpp
   src/io/msh_write.cpp
   src/io/surface_read.cpp
+  src/io/vtk_node_order.cpp
+  src/io/vtu_write.cpp
+  src/io/svg_common.cpp
+  src/io/svg_histogram.cpp
+  src/io/svg_mesh.cpp
 )

@@ -238,9 +238,11 @@ Mesh read_stl(std::string_view bytes, const std::string& file, std::vector<std::
     std::memcpy(&count, bytes.data() + 80, 4);
     if (84 + 50 * static_cast<std::uint64_t>(count) == bytes.size()) return read_stl_binary(bytes, file, count);
   }
+  // ASCII STL never holds a NUL byte; a binary one (even with a "solid" header) nearly always does.
+  const bool text = bytes.find('\0') == std::string_view::npos;
   std::size_t start = 0;
   while (start < bytes.size() && TextCursor::is_space(bytes[start])) ++start;
-  if (bytes.substr(start, 5) == "solid") return read_stl_ascii(bytes, file);
+  if (text && bytes.substr(start, 5) == "solid") return read_stl_ascii(bytes, file);
   if (bytes.size() >= 84) {
     std::uint32_t count;
     std::memcpy(&count, bytes.data() + 80, 4);

@@ -94,7 +94,9 @@ std::string mesh_svg(const Mesh& mesh, std::span<const double> values,
   const double draw_w = dx * scale, draw_h = dy * scale;
   const double margin = 20, title_h = options.title.empty() ? 0 : 34;
   const double bar_x = margin + draw_w + 30, bar_w = 22, bar_h = std::max(draw_h, 200.0);
-  const double total_w = bar_x + bar_w + 70, total_h = title_h + margin + bar_h + margin + 10;
+  // Wide enough for the title too (about 0.6 em per character of an 18 px sans-serif font).
+  const double total_w = std::max(bar_x + bar_w + 70, 2 * margin + 0.6 * 18 * options.title.size());
+  const double total_h = title_h + margin + bar_h + margin + 10;
   const double x0 = margin, y0 = title_h + margin;
 
   std::string out = svg_detail::begin_document(total_w, total_h);

@@ -1,5 +1,6 @@
 #include "dual_graph.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -68,10 +69,19 @@ DualGraph build_dual_graph(const DualGraphInput& in) {
   DualGraph g;
   g.num_triangles = static_cast<std::uint32_t>(tris.size());
   g.pairs.reserve(3 * tris.size() / 2 + 16);
+  std::vector<char> has_forbidden(tris.size(), 0);
+  if (in.forbidden_pairs != nullptr)
+    for (const auto& f : *in.forbidden_pairs) has_forbidden[std::min(f[0], f[1])] = 1;
+  auto forbidden = [&](std::uint32_t t, std::uint32_t u) {
+    if (!has_forbidden[t]) return false;
+    for (const auto& f : *in.forbidden_pairs)
+      if (std::min(f[0], f[1]) == t && std::max(f[0], f[1]) == u) return true;
+    return false;
+  };
   for (std::uint32_t t = 0; t < tris.size(); ++t)
     for (int k = 0; k < 3; ++k) {
       const std::uint32_t u = topo.neighbors[t][k];
-      if (u != kNoTriangle && t < u && region[t] == region[u])
+      if (u != kNoTriangle && t < u && region[t] == region[u] && !forbidden(t, u))
         g.pairs.push_back({t, u, 0.0, PairKind::real, static_cast<std::uint8_t>(k), 0});
     }
   g.num_real = g.pairs.size();

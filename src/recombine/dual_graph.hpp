@@ -63,6 +63,8 @@ struct DualGraphInput {
   double cross_field_angle = 0.0;
   bool extra_edges = true;
   double extra_edge_cost = 1000.0;
+  /// Triangle pairs (t0 < t1) never to merge (the halves of a split triangle).
+  const std::vector<std::array<std::uint32_t, 2>>* forbidden_pairs = nullptr;
 };
 
 /// Builds the graph. Extra pairs (§5.3) join the triangles t, t' of two successive boundary

@@ -186,7 +186,7 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   DualGraphInput gin{&s.coords, &s.triangles, &s.region, s.node_tags.size(), options.cost,
                      &field, options.cross_field_angle,
                      options.extra_edges && options.algorithm == RecombineAlgorithm::blossom,
-                     options.extra_edge_cost};
+                     options.extra_edge_cost, &s.forbidden_pairs};
   const DualGraph graph = build_dual_graph(gin);
   stats.graph_pairs = graph.num_real;
   stats.extra_pairs = graph.pairs.size() - graph.num_real;

@@ -28,8 +28,12 @@ std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const Smoothing
 
   std::size_t accepted = 0;
   std::vector<double> trial;
-  for (int pass = 0; pass < options.passes; ++pass) {
+  for (int pass = 0; pass < 2 * options.passes; ++pass) {
+    const bool raise_mean = pass >= options.passes;
     std::size_t accepted_this_pass = 0;
+    double global_min = 2.0;
+    for (std::size_t e = 0; e < m.elements.size(); ++e)
+      if (m.alive[e]) global_min = std::min(global_min, score[e]);
     for (NodeIndex v = 0; v < n; ++v) {
       if (fixed[v] || offsets[v] == offsets[v + 1]) continue;
       const std::array<double, 3> x = m.point(v);
@@ -68,12 +72,18 @@ std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const Smoothing
       for (double fraction : {1.0, 0.5}) {
         for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d] + fraction * move[d];
         trial.clear();
-        double new_min = 2.0;
-        for (std::uint32_t i = offsets[v]; i < offsets[v + 1] && new_min >= old_min; ++i) {
+        double new_min = 2.0, new_sum = 0, old_sum = 0;
+        for (std::uint32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
           trial.push_back(element_score(m, incident[i]));
           new_min = std::min(new_min, trial.back());
+          new_sum += trial.back();
+          old_sum += score[incident[i]];
         }
-        if (new_min >= old_min) {
+        // Phase 1: never lower the worst element at v. Phase 2: also take moves that raise
+        // the sum of the scores at v while keeping them above the mesh's current worst.
+        const bool ok = new_min >= old_min ||
+                        (raise_mean && new_min >= global_min && new_min > 0 && new_sum > old_sum);
+        if (ok) {
           for (std::uint32_t i = offsets[v]; i < offsets[v + 1]; ++i)
             score[incident[i]] = trial[i - offsets[v]];
           ++accepted_this_pass;
@@ -83,7 +93,7 @@ std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const Smoothing
       }
     }
     accepted += accepted_this_pass;
-    if (accepted_this_pass == 0) break;
+    if (accepted_this_pass == 0 && raise_mean) break;
   }
   return accepted;
 }

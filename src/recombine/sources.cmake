@@ -10,6 +10,8 @@ list(APPEND QUADVAL_SOURCES
   src/recombine/refine.cpp
   src/recombine/recombine_stats.cpp
   src/recombine/recombine.cpp
+  src/recombine/lookahead_state.cpp
+  src/recombine/lookahead_tree.cpp
 )
 list(APPEND QUADVAL_SOURCES src/recombine/lemon_matching.cpp)
 # LEMON 1.3 calls std::allocator::construct/destroy, removed in C++20: this one file is C++17.

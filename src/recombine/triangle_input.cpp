@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include <fmt/core.h>
@@ -198,7 +199,12 @@ void make_regions_even(TriangleSurface& s) {
     const std::uint32_t t = topo.edge_triangles[topo.edge_triangle_offsets[e]];
     const auto r = static_cast<std::size_t>(s.region[t]);
     if (count[r] % 2 == 0) continue;
-    const double len = squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1]);
+    // Prefer edges whose end nodes have 3 or more triangles: at a node with two, the halves'
+    // neighbours could only form a quad with a flat (180-degree) corner there.
+    const bool roomy = topo.vertex_triangles[topo.edges[e][0]] >= 3 &&
+                       topo.vertex_triangles[topo.edges[e][1]] >= 3;
+    const double len = squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1]) +
+                       (roomy ? 1e300 * 0 + std::numeric_limits<double>::max() / 4 : 0.0);
     if (len > best_length[r]) {
       best_length[r] = len;
       best_edge[r] = e;
@@ -225,6 +231,7 @@ void make_regions_even(TriangleSurface& s) {
     // (a, b, c) with the split edge a-b becomes (a, m, c) and (m, b, c): same orientation.
     const NodeIndex a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
     s.triangles[t] = {a, m, c};
+    s.forbidden_pairs.push_back({t, static_cast<std::uint32_t>(s.triangles.size())});
     s.triangles.push_back({m, b, c});
     s.region.push_back(s.region[t]);
     s.triangle_tags.push_back(s.triangle_tags[t]);

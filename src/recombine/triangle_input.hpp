@@ -22,6 +22,9 @@ struct TriangleSurface {
   std::vector<int> region_entity;                   ///< entity tag of each region
   std::size_t flipped = 0;                          ///< triangles reversed to orient consistently
   std::size_t odd_splits = 0;
+  /// The two halves of each split triangle: merged they would give back the triangle, a quad
+  /// with a flat corner at the new node, so they must not be paired.
+  std::vector<std::array<std::uint32_t, 2>> forbidden_pairs;
   std::vector<std::int32_t> odd_regions_left;       ///< odd regions that could not be split
   bool planar = true;                               ///< all nodes at one z
 };

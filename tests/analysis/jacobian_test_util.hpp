@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/lagrange_basis.hpp"
 
@@ -113,7 +114,7 @@ inline std::vector<RefPoint> dense_points(ElementFamily f, int m, int random_cou
 inline std::vector<const ElementType*> analysed_types(int max_order_2d, int max_order_3d) {
   std::vector<const ElementType*> out;
   for (const ElementType& t : element_types()) {
-    if (!t.has_lagrange_basis || t.order < 1) continue;
+    if (!t.has_lagrange_basis || t.order < 1 || t.order > max_supported_order(t.family)) continue;
     switch (t.family) {
       case ElementFamily::line:
       case ElementFamily::triangle:

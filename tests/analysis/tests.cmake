@@ -1,4 +1,6 @@
 list(APPEND QUADVAL_TEST_SOURCES
   analysis/jacobian_bounds_test.cpp
   analysis/jacobian_exact_test.cpp
+  analysis/gmsh_agreement_test.cpp
+  analysis/check_cli_test.cpp
 )

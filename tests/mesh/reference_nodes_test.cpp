@@ -207,8 +207,9 @@ TEST(ReferenceNodes, VerticesEdgesFacesAndInteriorAreWhereTheLayoutSays) {
         }
       }
     }
+    if (t->family == F::point) continue;
     for (int k = layout.interior_begin; k < layout.num_nodes; ++k)
-      if (t->family != F::point) EXPECT_TRUE(strictly_inside(t->family, nodes[k])) << "node " << k;
+      EXPECT_TRUE(strictly_inside(t->family, nodes[k])) << "node " << k;
   }
 }
 

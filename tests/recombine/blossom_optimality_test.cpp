@@ -108,7 +108,7 @@ DualGraph graph_of(const TriangleSurface& s, bool extra_edges) {
 
 TEST(BlossomOptimality, EqualsBruteForceOnHundredsOfSmallMeshes) {
   int perfect = 0, without = 0;
-  for (unsigned seed = 1; seed <= 300; ++seed) {
+  for (unsigned seed = 1; seed <= 200; ++seed) {
     const int nx = 2 + static_cast<int>(seed % 2), ny = 2 + static_cast<int>((seed / 2) % 2);
     const Mesh m = test::random_grid_mesh(nx, ny, seed, static_cast<int>(seed % 4));
     SCOPED_TRACE(::testing::Message() << "seed " << seed);
@@ -132,7 +132,7 @@ TEST(BlossomOptimality, EqualsBruteForceOnHundredsOfSmallMeshes) {
     EXPECT_NEAR(with_extra.cost, want, 1e-8 * static_cast<double>(s.triangles.size()));
   }
   // The generator must exercise both cases.
-  EXPECT_GT(perfect, 150);
+  EXPECT_GT(perfect, 100);
   EXPECT_GT(without, 0);
 }
 

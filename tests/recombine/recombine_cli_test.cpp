@@ -17,12 +17,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Run {
+struct CliRun {
   int code;
   std::string output;  // stdout and stderr
 };
 
-Run run_cli(const std::string& args) {
+CliRun run_cli(const std::string& args) {
   const fs::path log = fs::temp_directory_path() / ("qv_cli_" + std::to_string(::getpid()) + ".log");
   const std::string cmd = std::string(QUADVAL_CLI_PATH) + " " + args + " > " + log.string() + " 2>&1";
   const int rc = std::system(cmd.c_str());
@@ -46,7 +46,7 @@ TEST_F(RecombineCli, RectSinGivesAllQuadMeshAndReport) {
   const fs::path in = fs::path(QUADVAL_SHARED_DIR) / "data/tri/rect-sin-a6.msh";
   if (!fs::exists(in)) GTEST_SKIP() << in << " missing";
   const fs::path out = dir_ / "q.msh", report = dir_ / "r.json";
-  const Run r = run_cli("recombine " + in.string() + " -o " + out.string() + " --report " +
+  const CliRun r = run_cli("recombine " + in.string() + " -o " + out.string() + " --report " +
                         report.string() + " --size-field '0.1+0.08*sin(3*x)*cos(6*y)'");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("[blossom]"), std::string::npos) << r.output;
@@ -68,7 +68,7 @@ TEST_F(RecombineCli, RectSinGivesAllQuadMeshAndReport) {
 TEST_F(RecombineCli, QuietPrintsNothing) {
   const fs::path in = fs::path(QUADVAL_SHARED_DIR) / "data/tri/rect-sin-a8.msh";
   if (!fs::exists(in)) GTEST_SKIP() << in << " missing";
-  const Run r = run_cli("recombine " + in.string() + " -o " + (dir_ / "q.vtu").string() + " -q");
+  const CliRun r = run_cli("recombine " + in.string() + " -o " + (dir_ / "q.msh").string() + " -q");
   EXPECT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output, "");
 }
@@ -77,7 +77,7 @@ TEST_F(RecombineCli, NonManifoldInputExitsTwoWithMessage) {
   const fs::path in = dir_ / "bad.off";
   std::ofstream(in) << "OFF\n5 3 0\n0 0 0\n1 0 0\n0 1 0\n0 -1 0\n1 1 0\n"
                        "3 0 1 2\n3 1 0 3\n3 0 1 4\n";
-  const Run r = run_cli("recombine " + in.string() + " -o " + (dir_ / "o.msh").string());
+  const CliRun r = run_cli("recombine " + in.string() + " -o " + (dir_ / "o.msh").string());
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("non-manifold"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir_ / "o.msh"));
@@ -86,7 +86,7 @@ TEST_F(RecombineCli, NonManifoldInputExitsTwoWithMessage) {
 TEST_F(RecombineCli, QuadInputAndBadSizeFieldExitTwo) {
   const fs::path in = dir_ / "quad.off";
   std::ofstream(in) << "OFF\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n";
-  Run r = run_cli("recombine " + in.string() + " -o " + (dir_ / "o.msh").string());
+  CliRun r = run_cli("recombine " + in.string() + " -o " + (dir_ / "o.msh").string());
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("triangles only"), std::string::npos) << r.output;
   const fs::path tri = dir_ / "tri.off";
@@ -102,7 +102,7 @@ TEST_F(RecombineCli, OddTriangleCountIsReportedAndStillAllQuad) {
   std::ofstream(in) << "OFF\n5 3 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 1.6 0\n"
                        "3 0 1 2\n3 0 2 3\n3 3 2 4\n";
   const fs::path out = dir_ / "o.msh";
-  const Run r = run_cli("recombine " + in.string() + " -o " + out.string());
+  const CliRun r = run_cli("recombine " + in.string() + " -o " + out.string());
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("odd number of triangles"), std::string::npos) << r.output;
   const Mesh q = read_mesh(out);

@@ -5,4 +5,6 @@ list(APPEND QUADVAL_TEST_SOURCES
   recombine/repair_test.cpp
   recombine/recombine_input_test.cpp
   recombine/recombine_cli_test.cpp
+  recombine/lookahead_criterion_test.cpp
+  recombine/lookahead_tree_test.cpp
 )

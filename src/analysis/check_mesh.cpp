@@ -1,0 +1,212 @@
+// check_mesh: the batched, threaded analysis of a whole mesh (Paper III §4.4: samples and
+// first Bézier coefficients for many elements at once; only the undecided few are
+// subdivided). Fixed chunks of one block make the results independent of the threads.
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "analysis/jacobian_engine.hpp"
+#include "analysis/jacobian_samples.hpp"
+#include "analysis/jacobian_space.hpp"
+#include "quadval/check_report.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr std::size_t kChunk = 256;
+
+double now_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// Per-thread accumulators, merged at the end (sums are order-independent integers; the
+// times are only reported).
+struct ThreadStats {
+  std::vector<StageRow> stages;
+  std::size_t exact = 0;
+  void add(int stage, Validity v, double seconds) {
+    const auto row = static_cast<std::size_t>(stage < 0 ? 0 : stage);
+    if (stages.size() <= row) stages.resize(row + 1);
+    if (v == Validity::valid) ++stages[row].valid;
+    if (v == Validity::invalid) ++stages[row].invalid;
+    stages[row].seconds += seconds;
+  }
+};
+
+std::string stage_name(std::size_t i) {
+  if (i == 0) return "samples";
+  if (i == 1) return "Bezier";
+  return std::to_string(i - 1) + (i == 2 ? " subdivision" : " subdivisions");
+}
+
+}  // namespace
+
+CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std::string& file) {
+  const double t0 = now_seconds();
+  CheckReport report;
+  report.file = file;
+  report.measure = options.measure;
+  report.dimension = mesh.dimension();
+  for (double c : mesh.coords)
+    if (!std::isfinite(c)) throw InputError::in_file(file, "a node coordinate is not finite");
+
+  // Planar 2D: every node of every 2D block has the same z.
+  if (report.dimension == 2) {
+    report.planar = true;
+    double z0 = NAN;
+    for (const ElementBlock& b : mesh.blocks) {
+      if (b.type->dim != 2) continue;
+      for (NodeIndex n : b.nodes) {
+        const double z = mesh.coords[3 * static_cast<std::size_t>(n) + 2];
+        if (std::isnan(z0)) z0 = z;
+        if (z != z0) report.planar = false;
+      }
+    }
+  }
+
+  BoundsOptions bo;
+  bo.goal = options.measure == CheckMeasure::validity ? BoundsGoal::validity : BoundsGoal::measure;
+  bo.rel_tol = options.rel_tol;
+  bo.abs_tol = options.abs_tol;
+  bo.max_subdivisions = options.max_subdivisions;
+
+  // Work list: (block, first element) chunks of the analysed dimension.
+  struct Chunk {
+    std::size_t block, first, count, out;
+  };
+  std::vector<Chunk> chunks;
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < mesh.blocks.size(); ++b) {
+    const ElementBlock& blk = mesh.blocks[b];
+    if (blk.type->dim != report.dimension) continue;
+    for (std::size_t e = 0; e < blk.size(); e += kChunk)
+      chunks.push_back({b, e, std::min(kChunk, blk.size() - e), total + e});
+    total += blk.size();
+  }
+  report.elements.resize(total);
+
+  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  report.threads = threads;
+  std::vector<ThreadStats> stats(static_cast<std::size_t>(threads));
+  std::atomic<std::size_t> done{0};
+  std::exception_ptr failure;
+  // Build the shared spaces up front (once per type, outside the parallel region).
+  for (const ElementBlock& blk : mesh.blocks)
+    if (blk.type->dim == report.dimension && jacobian_supported(*blk.type)) (void)jacobian_space(*blk.type);
+
+#pragma omp parallel num_threads(threads)
+  {
+    BoundsWorkspace workspace;
+    auto& ws = workspace.impl();
+    ThreadStats& st = stats[static_cast<std::size_t>(omp_get_thread_num())];
+    std::vector<double> nodes, samples, errors;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+      try {
+        const Chunk& ch = chunks[c];
+        const ElementBlock& blk = mesh.blocks[ch.block];
+        const ElementType& type = *blk.type;
+        for (std::size_t i = 0; i < ch.count; ++i) {
+          ElementCheck& ec = report.elements[ch.out + i];
+          ec.tag = blk.tags[ch.first + i];
+          ec.type = &type;
+        }
+        if (jacobian_supported(type)) {
+          const JacobianSpace& space = jacobian_space(type);
+          const auto nn = static_cast<std::size_t>(type.num_nodes);
+          const auto s = static_cast<std::size_t>(space.num_samples());
+          nodes.resize(ch.count * nn * 3);
+          for (std::size_t i = 0; i < ch.count; ++i) {
+            const auto conn = blk.element(ch.first + i);
+            for (std::size_t k = 0; k < nn; ++k)
+              for (std::size_t j = 0; j < 3; ++j)
+                nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+          }
+          samples.resize(ch.count * s);
+          errors.resize(ch.count);
+          const double ts = now_seconds();
+          jacobian_samples(space, SampleMap::curved, nodes.data(), ch.count, report.planar,
+                           samples.data(), errors.data(), ws.sample_scratch);
+          const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
+          for (std::size_t i = 0; i < ch.count; ++i) {
+            const double te = now_seconds();
+            ElementCheck& ec = report.elements[ch.out + i];
+            const double* xe = nodes.data() + i * nn * 3;
+            ec.analysed = true;
+            ec.bounds = bounds_from_samples(space, samples.data() + i * s, errors[i], xe,
+                                            report.planar, bo, ws);
+            const JacobianBounds& b = ec.bounds;
+            if (b.jmax_upper > 0) ec.ratio_lower = std::nextafter(b.jmin_lower / b.jmax_upper, -INFINITY);
+            if (b.javg > 0) ec.jmin_over_javg = b.jmin_lower / b.javg;
+            if (options.measure == CheckMeasure::distortion)
+              ec.distortion = distortion_from(space, xe, report.planar, b, ws);
+            if (b.exact) ++st.exact;
+            st.add(b.stage, b.validity, batch_share + (now_seconds() - te));
+          }
+        }
+        const std::size_t d = done.fetch_add(ch.count) + ch.count;
+        if (options.progress && omp_get_thread_num() == 0) options.progress(d, total);
+      } catch (...) {
+#pragma omp critical
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+
+  for (const ThreadStats& st : stats) {
+    report.exact_fallbacks += st.exact;
+    if (report.stages.size() < st.stages.size()) report.stages.resize(st.stages.size());
+    for (std::size_t i = 0; i < st.stages.size(); ++i) {
+      report.stages[i].valid += st.stages[i].valid;
+      report.stages[i].invalid += st.stages[i].invalid;
+      report.stages[i].seconds += st.stages[i].seconds;
+    }
+  }
+  if (report.stages.size() < 2) report.stages.resize(2);
+  for (std::size_t i = 0; i < report.stages.size(); ++i) report.stages[i].name = stage_name(i);
+  for (const ElementCheck& ec : report.elements) {
+    auto& c = report.counts[ec.type->gmsh_id];
+    c[ec.analysed ? static_cast<std::size_t>(ec.bounds.validity) : 3] += 1;
+  }
+  report.seconds = now_seconds() - t0;
+  return report;
+}
+
+std::size_t CheckReport::count(Validity v) const {
+  std::size_t n = 0;
+  for (const auto& [id, c] : counts) n += c[static_cast<std::size_t>(v)];
+  return n;
+}
+
+std::size_t CheckReport::skipped() const {
+  std::size_t n = 0;
+  for (const auto& [id, c] : counts) n += c[3];
+  return n;
+}
+
+std::vector<std::size_t> CheckReport::worst(std::size_t n) const {
+  std::vector<std::size_t> idx;
+  const bool by_distortion = measure == CheckMeasure::distortion;
+  const auto key = [&](std::size_t i) {
+    const ElementCheck& e = elements[i];
+    const double k = by_distortion ? e.distortion.lower : e.ratio_lower;
+    return std::isnan(k) ? -INFINITY : k;
+  };
+  for (std::size_t i = 0; i < elements.size(); ++i)
+    if (elements[i].analysed) idx.push_back(i);
+  const std::size_t m = std::min(n, idx.size());
+  std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m), idx.end(),
+                    [&](std::size_t a, std::size_t b) {
+                      const double ka = key(a), kb = key(b);
+                      return ka != kb ? ka < kb : elements[a].tag < elements[b].tag;
+                    });
+  idx.resize(m);
+  return idx;
+}
+
+}  // namespace quadval

@@ -1,0 +1,191 @@
+// The look-ahead trees of Paper II against brute-force oracles written here.
+#include <omp.h>
+
+#include <set>
+#include <unordered_map>
+
+#include <gtest/gtest.h>
+
+#include "recombine/lookahead_test_support.hpp"
+#include "recombine/lookahead_tree.hpp"
+#include "recombine/test_meshes.hpp"
+
+namespace quadval {
+namespace {
+
+using recombine_detail::LookaheadGraph;
+using recombine_detail::lookahead_run;
+
+std::vector<char> free_after(const LookaheadGraph& g, const std::vector<std::uint32_t>& pairs) {
+  std::vector<char> free(g.num_triangles, 1);
+  for (std::uint32_t p : pairs) {
+    EXPECT_TRUE(free[g.pairs[p].t0] && free[g.pairs[p].t1]) << "pair " << p << " reused";
+    free[g.pairs[p].t0] = free[g.pairs[p].t1] = 0;
+  }
+  return free;
+}
+
+bool even_components(const test::LookaheadFixture& f, const std::vector<char>& free) {
+  for (std::size_t n : test::component_sizes(f, free))
+    if (n % 2 == 1) return false;
+  return true;
+}
+
+// Every merge respected Definition 2 at its time, and the end state has no allowed merge.
+void expect_valid_sequence(const test::LookaheadFixture& f, const std::vector<std::uint32_t>& pairs) {
+  const LookaheadGraph& g = f.graph;
+  std::vector<char> free(g.num_triangles, 1);
+  for (std::uint32_t p : pairs) {
+    ASSERT_TRUE(test::oracle_allowed(f, free, g.pairs[p].t0, g.pairs[p].t1)) << "pair " << p;
+    free[g.pairs[p].t0] = free[g.pairs[p].t1] = 0;
+  }
+  for (const auto& q : g.pairs) EXPECT_FALSE(test::oracle_allowed(f, free, q.t0, q.t1));
+}
+
+// Greedy with the criterion (§6.2), by brute force: at each step the allowed pair of largest
+// reward. Rewards are distinct in the meshes used, so the sequence is unique.
+std::vector<std::uint32_t> oracle_greedy(const test::LookaheadFixture& f) {
+  const LookaheadGraph& g = f.graph;
+  std::vector<char> free(g.num_triangles, 1);
+  std::vector<std::uint32_t> seq;
+  while (true) {
+    std::uint32_t best = recombine_detail::kNone;
+    for (std::uint32_t p = 0; p < g.pairs.size(); ++p)
+      if (test::oracle_allowed(f, free, g.pairs[p].t0, g.pairs[p].t1) &&
+          (best == recombine_detail::kNone || g.reward[p] > g.reward[best]))
+        best = p;
+    if (best == recombine_detail::kNone) return seq;
+    seq.push_back(best);
+    free[g.pairs[best].t0] = free[g.pairs[best].t1] = 0;
+  }
+}
+
+// Best q over all sequences of allowed merges (any final state), and over those that merge
+// every triangle (-1 if none), by exhaustive search memoized on the set of free triangles.
+struct Optimum {
+  double any = 0.0;
+  double perfect = -1.0;
+};
+Optimum oracle_optimum(const test::LookaheadFixture& f) {
+  const LookaheadGraph& g = f.graph;
+  EXPECT_LE(g.num_triangles, 62u);
+  std::unordered_map<std::uint64_t, Optimum> memo;
+  std::function<Optimum(std::uint64_t)> best = [&](std::uint64_t mask) -> Optimum {
+    if (auto it = memo.find(mask); it != memo.end()) return it->second;
+    std::vector<char> free(g.num_triangles);
+    for (std::uint32_t t = 0; t < g.num_triangles; ++t) free[t] = (mask >> t) & 1;
+    Optimum o;
+    if (mask == 0) o.perfect = 0.0;
+    for (std::uint32_t p = 0; p < g.pairs.size(); ++p) {
+      const auto& q = g.pairs[p];
+      if (!test::oracle_allowed(f, free, q.t0, q.t1)) continue;
+      const Optimum r = best(mask & ~(std::uint64_t{1} << q.t0) & ~(std::uint64_t{1} << q.t1));
+      o.any = std::max(o.any, g.reward[p] + r.any);
+      if (r.perfect >= 0) o.perfect = std::max(o.perfect, g.reward[p] + r.perfect);
+    }
+    memo[mask] = o;
+    return o;
+  };
+  return best((std::uint64_t{1} << g.num_triangles) - 1);
+}
+
+bool distinct_rewards(const LookaheadGraph& g) {
+  std::set<double> r(g.reward.begin(), g.reward.end());
+  return r.size() == g.reward.size() && *r.begin() > 0.0;
+}
+
+TEST(LookaheadTree, UniformHorizonOneIsGreedyWithTheCriterion) {
+  int compared = 0;
+  for (unsigned seed = 1; seed <= 30; ++seed) {
+    const Mesh m = test::random_grid_mesh(4 + seed % 4, 3 + seed % 3, seed, 2, true, 0.12);
+    const auto f = test::make_lookahead_fixture(m);
+    if (!distinct_rewards(f.graph) || !even_components(f, std::vector<char>(f.graph.num_triangles, 1)))
+      continue;
+    LookaheadOptions o;
+    o.tree = LookaheadTree::uniform;
+    o.horizon = 1;
+    const auto fast = lookahead_run(f.graph, o, seed);
+    EXPECT_EQ(fast.pairs, oracle_greedy(f)) << "seed " << seed;
+    expect_valid_sequence(f, fast.pairs);
+    ++compared;
+  }
+  EXPECT_GE(compared, 15);
+}
+
+TEST(LookaheadTree, FullHorizonFindsTheBruteForceOptimum) {
+  int compared = 0, perfect = 0;
+  for (unsigned seed = 1; seed <= 14; ++seed) {
+    const Mesh m = test::random_grid_mesh(3, 2 + seed % 2, 40 + seed, seed % 2, true, 0.3);
+    const auto f = test::make_lookahead_fixture(m);
+    if (!even_components(f, std::vector<char>(f.graph.num_triangles, 1))) continue;
+    const Optimum want = oracle_optimum(f);
+    const int full = static_cast<int>(f.graph.num_triangles / 2);
+    LookaheadOptions uniform;
+    uniform.tree = LookaheadTree::uniform;
+    uniform.horizon = full;
+    const auto u = lookahead_run(f.graph, uniform, seed);
+    EXPECT_NEAR(u.run.quality, want.any, 1e-12) << "seed " << seed;
+    expect_valid_sequence(f, u.pairs);
+    // §5: when the optimum merges every triangle, the selective tree at full depth holds it.
+    LookaheadOptions selective;
+    selective.horizon = full;
+    const auto s = lookahead_run(f.graph, selective, seed);
+    expect_valid_sequence(f, s.pairs);
+    EXPECT_LE(s.run.quality, want.any + 1e-12);
+    if (want.perfect >= 0) {
+      EXPECT_GE(s.run.quality, want.perfect - 1e-12) << "seed " << seed;
+      ++perfect;
+    }
+    ++compared;
+  }
+  EXPECT_GE(compared, 8);
+  EXPECT_GE(perfect, 6);
+}
+
+TEST(LookaheadTree, SelectiveRunsKeepTheCriterionAndEndInAFinalState) {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const Mesh m = test::random_grid_mesh(12, 9, 200 + seed, 6);
+    const auto f = test::make_lookahead_fixture(m);
+    if (!even_components(f, std::vector<char>(f.graph.num_triangles, 1))) continue;
+    for (int h : {1, 3, 6}) {
+      LookaheadOptions o;
+      o.horizon = h;
+      const auto r = lookahead_run(f.graph, o, seed);
+      expect_valid_sequence(f, r.pairs);
+      EXPECT_TRUE(even_components(f, free_after(f.graph, r.pairs)));
+      double q = 0;
+      for (std::uint32_t p : r.pairs) q += f.graph.reward[p];
+      EXPECT_NEAR(r.run.quality, q, 1e-9);
+      EXPECT_EQ(r.run.triangles_left, f.graph.num_triangles - 2 * r.pairs.size());
+    }
+  }
+}
+
+TEST(LookaheadTree, BestOfRunsIsTheSameForAnyThreadCount) {
+  const Mesh m = test::random_grid_mesh(14, 10, 77);
+  const auto f = test::make_lookahead_fixture(m);
+  LookaheadOptions o;
+  o.horizon = 3;
+  o.runs = 7;
+  o.seed = 1234;
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const auto one = recombine_detail::lookahead_best_of(f.graph, o);
+  omp_set_num_threads(3);
+  const auto three = recombine_detail::lookahead_best_of(f.graph, o);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(one.best_run, three.best_run);
+  EXPECT_EQ(one.best.pairs, three.best.pairs);
+  ASSERT_EQ(one.runs.size(), 7u);
+  for (std::size_t i = 0; i < 7; ++i) {
+    EXPECT_EQ(one.runs[i].seed, 1234 + i);
+    EXPECT_EQ(one.runs[i].quality, three.runs[i].quality);
+    EXPECT_LE(one.runs[i].quality, one.best.run.quality);
+  }
+  // Run i alone reproduces the figures of run i.
+  const auto alone = lookahead_run(f.graph, o, 1234 + one.best_run);
+  EXPECT_EQ(alone.pairs, one.best.pairs);
+}
+
+}  // namespace
+}  // namespace quadval
