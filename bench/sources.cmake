@@ -1,4 +1,6 @@
 list(APPEND QUADVAL_BENCH_SOURCES
   recombine_bench.cpp
   io_bench.cpp
+  pyramid_bench.cpp
+  jacobian_bench.cpp
 )

@@ -36,6 +36,9 @@ struct RecombineCliOptions {
   bool no_optimize = false, full_quad = false, quiet = false, binary = false;
   bool no_extra_edges = false;
   double extra_edge_cost = 1000.0;
+  int horizon = 3, runs = 1;
+  std::uint64_t seed = 1;
+  bool uniform = false, selective = false, compare_blossom = false;
 };
 
 // One angle in degrees per line ('#' starts a comment; blank lines skipped).
@@ -107,6 +110,10 @@ int run(const RecombineCliOptions& o) {
   RecombineOptions options;
   options.source = o.input;
   options.algorithm = o.algo == "greedy" ? RecombineAlgorithm::greedy : RecombineAlgorithm::blossom;
+  if (o.algo == "lookahead") options.algorithm = RecombineAlgorithm::lookahead;
+  options.lookahead = {o.horizon, o.uniform ? LookaheadTree::uniform : LookaheadTree::selective,
+                       o.seed, o.runs};
+  options.compare_with_blossom = o.compare_blossom;
   options.cost = o.cost == "crossfield" ? PairCostKind::cross_field : PairCostKind::angle;
   options.cross_field_angle = o.cross_field_degrees * std::numbers::pi / 180.0;
   if (!o.cross_field_file.empty()) options.cross_field_per_triangle = read_cross_field(o.cross_field_file);
@@ -156,6 +163,15 @@ int run(const RecombineCliOptions& o) {
     fmt::print("  interior vertices of degree 4: {:.1f}%  degree min {} max {}\n",
                100.0 * s.degree4_share, s.degree_min, s.degree_max);
     if (s.has_tau) fmt::print("  efficiency index tau {:.1f}%\n", s.tau);
+    if (options.algorithm == RecombineAlgorithm::lookahead) {
+      fmt::print("  look-ahead: q {:.2f}, {:.2f}% of the triangles recombined, {} left before "
+                 "post-process, {} after (best of {} runs: run {})\n",
+                 s.lookahead_quality, 100.0 * s.recombined_share, s.lookahead_triangles_left,
+                 s.triangles, s.lookahead_runs.size(), s.lookahead_best_run);
+      if (s.quality_percent_of_blossom >= 0)
+        fmt::print("  Blossom q {:.2f}: look-ahead reaches {:.2f}%\n", s.blossom_quality,
+                   s.quality_percent_of_blossom);
+    }
     fmt::print("  total cost {:.6g}, extra pairs matched {} (swaps {}, duplications {})\n",
                s.matching_cost, s.matched_extra_pairs, s.edge_swaps, s.vertex_duplications);
     fmt::print("  time: read {:.3f} s, recombine {:.3f} s, write {:.3f} s, total {:.3f} s\n",
@@ -171,6 +187,20 @@ int run(const RecombineCliOptions& o) {
                              {"read_seconds", read_seconds}, {"write_seconds", write_seconds},
                              {"end_to_end_seconds", total}};
     if (!o.size_field.empty()) report["size_field"] = o.size_field;
+    if (options.algorithm == RecombineAlgorithm::lookahead) {
+      nlohmann::json runs = nlohmann::json::array();
+      for (const LookaheadRun& r : s.lookahead_runs)
+        runs.push_back({{"seed", r.seed}, {"quality", r.quality}, {"quads", r.quads},
+                        {"triangles_left", r.triangles_left}, {"seconds", r.seconds}});
+      report["lookahead"] = {
+          {"tree", o.uniform ? "uniform" : "selective"}, {"horizon", o.horizon},
+          {"seed", o.seed}, {"runs", runs}, {"best_run", s.lookahead_best_run},
+          {"quality", s.lookahead_quality}, {"recombined_share", s.recombined_share},
+          {"triangles_left_before_post_process", s.lookahead_triangles_left},
+          {"triangles_left_after_post_process", s.triangles},
+          {"blossom_quality", s.blossom_quality >= 0 ? nlohmann::json(s.blossom_quality) : nlohmann::json(nullptr)},
+          {"quality_percent_of_blossom", s.quality_percent_of_blossom >= 0 ? nlohmann::json(s.quality_percent_of_blossom) : nlohmann::json(nullptr)}};
+    }
     write_file_atomically(o.report, [&](std::ostream& out) { out << report.dump(2) << "\n"; });
   }
   return kExitOk;
@@ -187,7 +217,7 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
   cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu); element field 'eta'")
       ->required();
   cmd->add_option("--algo", o->algo, "blossom (optimal, all-quad) or greedy (quad-dominant)")
-      ->check(CLI::IsMember({"blossom", "greedy"}))
+      ->check(CLI::IsMember({"blossom", "greedy", "lookahead"}))
       ->capture_default_str();
   cmd->add_option("--cost", o->cost, "Pair cost: angle (1 - eta, eq. 3) or crossfield (eq. 7)")
       ->check(CLI::IsMember({"angle", "crossfield"}))
@@ -215,6 +245,21 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--no-extra-edges", o->no_extra_edges, "Do not add the extra boundary edges (§5.3)");
   cmd->add_option("--extra-edge-cost", o->extra_edge_cost, "Cost of an extra boundary edge")
       ->capture_default_str();
+  cmd->add_option("--horizon", o->horizon, "lookahead: depth of the look-ahead tree")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  auto* uniform = cmd->add_flag("--uniform", o->uniform,
+                                "lookahead: uniform tree (every allowed merge; small meshes)");
+  cmd->add_flag("--selective", o->selective, "lookahead: selective tree (the default)")
+      ->excludes(uniform);
+  cmd->add_option("--seed", o->seed, "lookahead: seed of run 0 (run i uses seed + i)")
+      ->capture_default_str();
+  cmd->add_option("--runs", o->runs, "lookahead: keep the best of N runs")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
+  cmd->add_flag("--compare-blossom", o->compare_blossom,
+                "lookahead: also solve Blossom on the same triangles and report the quality "
+                "as a percentage of its optimum");
   cmd->add_option("--report", o->report, "Write the statistics as JSON to this file");
   cmd->add_flag("--binary", o->binary, "Binary MSH output");
   cmd->add_flag("-q,--quiet", o->quiet, "No log and no summary");

@@ -65,6 +65,8 @@ class BernsteinSimplex {
   /// T (size x size, row-major): Bézier coefficients = T * values at the points (eq. 18),
   /// each entry the double nearest to the exact rational.
   std::span<const double> lagrange_to_bezier() const noexcept { return to_bezier_; }
+  /// The same matrix transposed (column-major), for vectorised products.
+  std::span<const double> lagrange_to_bezier_transposed() const noexcept { return to_bezier_t_; }
   /// max_i sum_j |T_ij| of the exact T, rounded up: how much an error in the samples can
   /// grow in the coefficients.
   double lagrange_to_bezier_norm() const noexcept { return to_bezier_norm_; }
@@ -83,17 +85,19 @@ class BernsteinSimplex {
   /// S_q (size x size, row-major): the child's Bézier coefficients = S_q * parent's
   /// (eq. 20). Entries are k / 2^n, nonnegative, each row sums to 1: exact in double.
   std::span<const double> subdivision(int child) const noexcept;
+  /// S_q transposed.
+  std::span<const double> subdivision_transposed(int child) const noexcept;
 
  private:
   int dim_;
   int degree_;
   std::vector<std::array<int, 4>> alphas_;
   std::vector<bool> vertex_;
-  std::vector<double> to_bezier_;
+  std::vector<double> to_bezier_, to_bezier_t_;
   double to_bezier_norm_ = 0;
   std::unique_ptr<Exact> exact_;
   std::vector<std::array<std::array<int, 4>, 4>> children_;
-  std::vector<double> subdivision_;  // num_children blocks of size*size
+  std::vector<double> subdivision_, subdivision_t_;  // num_children blocks of size*size
 };
 
 /// The shared factor of (dim, degree); thread-safe, built once.
@@ -143,6 +147,12 @@ class BezierBasis {
   /// Bézier coefficients from samples at the points (eq. 18), factor by factor.
   /// @pre samples, coeffs: size(); scratch: 2 * size(); coeffs may not alias samples
   void to_bezier(const double* samples, double* coeffs, double* scratch) const;
+  /// The same for `count` elements at once (a matrix-matrix product, DESIGN.md
+  /// "Batching"); layout [k * count + e], element fastest. Every element's coefficients
+  /// are summed in the same order as to_bezier's, so results are bit-identical.
+  /// @pre samples, coeffs: size() * count; scratch: 2 * size() * count
+  void to_bezier_batch(const double* samples, std::size_t count, double* coeffs,
+                       double* scratch) const;
   /// Product of the factor norms (rounded up): |exact T| row-sum bound of the whole T.
   double to_bezier_norm() const noexcept { return to_bezier_norm_; }
   /// Rounding of to_bezier: |computed - exact T applied to the same doubles| <=
@@ -162,7 +172,8 @@ class BezierBasis {
 
  private:
   template <class MatrixOf>
-  void apply_factors(const double* in, double* out, double* scratch, MatrixOf matrix_of) const;
+  void apply_factors(const double* in, double* out, double* scratch, std::size_t count,
+                     MatrixOf matrix_of) const;
 
   ElementFamily family_;
   int order_;

@@ -43,8 +43,11 @@ std::span<const ElementType> element_types() noexcept;
 /// The type with this Gmsh id, or nullptr if Gmsh defines no such id.
 const ElementType* find_element_type(int gmsh_id) noexcept;
 
-/// The Lagrange type of a family and order, or nullptr (e.g. order 3 incomplete line).
-/// Incomplete types have vertex and edge nodes only.
+/// The Lagrange type of a family and order, or nullptr (e.g. any line of order 11).
+/// Incomplete types have vertex and edge nodes only; asking for the incomplete type of a
+/// family and order whose complete type has no face or interior node (lines, order 1,
+/// order-2 triangles and tetrahedra) gives that complete type, as Gmsh's
+/// getElementType(family, order, serendip=True) does.
 const ElementType* find_element_type(ElementFamily family, int order, bool complete) noexcept;
 
 }  // namespace quadval

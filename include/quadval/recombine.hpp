@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "quadval/lookahead.hpp"
 #include "quadval/mesh.hpp"
 
 namespace quadval {
@@ -23,6 +24,7 @@ namespace quadval {
 enum class RecombineAlgorithm {
   blossom,  ///< optimal: min-cost perfect matching (Paper I §4)
   greedy,   ///< best pair first, isolated triangles stay (Paper I §3)
+  lookahead,  ///< look-ahead tree (Paper II), options in RecombineOptions::lookahead
 };
 
 enum class PairCostKind {
@@ -67,6 +69,11 @@ struct RecombineOptions {
   /// Optional size field: weights the smoothing (so that it keeps the gradation) and gives the
   /// efficiency index tau of eq. (1)-(2) in the statistics.
   SizeFunction size_field;
+  /// RecombineAlgorithm::lookahead: tree, horizon, seed, runs. Leftover triangles become
+  /// quads with full_quad (the documented all-quad post-process: Fig. 2 refinement).
+  LookaheadOptions lookahead;
+  /// lookahead: also solve Blossom on the same pairs, for quality_percent_of_blossom.
+  bool compare_with_blossom = false;
   /// Name of the input for error messages (e.g. the file path).
   std::string source = "<mesh>";
   /// Stage log lines ("[blossom] 18342 pairs, 3.1 ms"); empty: silent.
@@ -106,6 +113,14 @@ struct RecombineStats {
   double tau = 0.0;                      ///< efficiency index, percent, eq. (1)-(2)
   std::vector<StageTime> times;
   double total_seconds = 0.0;
+  // RecombineAlgorithm::lookahead (Paper II).
+  double lookahead_quality = 0.0;           ///< q = sum of eta of the merges (best run)
+  std::size_t lookahead_triangles_left = 0; ///< before any post-process
+  double recombined_share = 0.0;            ///< share of the triangles merged (best run)
+  std::size_t lookahead_best_run = 0;
+  std::vector<LookaheadRun> lookahead_runs; ///< every run, in run order
+  double blossom_quality = -1.0;            ///< compare_with_blossom: Blossom's q, else -1
+  double quality_percent_of_blossom = -1.0; ///< 100 q / Blossom's q, else -1
 };
 
 struct RecombineResult {

@@ -11,6 +11,7 @@
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/outward_rounding.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
 
@@ -103,7 +104,7 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(omp_get_thread_num())];
-    std::vector<double> nodes, samples, errors;
+    std::vector<double> nodes, samples, errors, transposed, coeffs_t, coeffs, scratch;
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t c = 0; c < chunks.size(); ++c) {
       try {
@@ -131,6 +132,16 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
           const double ts = now_seconds();
           jacobian_samples(space, SampleMap::curved, nodes.data(), ch.count, report.planar,
                            samples.data(), errors.data(), ws.sample_scratch);
+          // First Bézier coefficients of the whole chunk: one matrix-matrix product.
+          transposed.resize(ch.count * s);
+          for (std::size_t i = 0; i < ch.count; ++i)
+            for (std::size_t k = 0; k < s; ++k) transposed[k * ch.count + i] = samples[i * s + k];
+          coeffs_t.resize(ch.count * s);
+          scratch.resize(2 * ch.count * s);
+          space.basis().to_bezier_batch(transposed.data(), ch.count, coeffs_t.data(), scratch.data());
+          coeffs.resize(ch.count * s);
+          for (std::size_t i = 0; i < ch.count; ++i)
+            for (std::size_t k = 0; k < s; ++k) coeffs[i * s + k] = coeffs_t[k * ch.count + i];
           const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
           for (std::size_t i = 0; i < ch.count; ++i) {
             const double te = now_seconds();
@@ -138,9 +149,9 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
             const double* xe = nodes.data() + i * nn * 3;
             ec.analysed = true;
             ec.bounds = bounds_from_samples(space, samples.data() + i * s, errors[i], xe,
-                                            report.planar, bo, ws);
+                                            report.planar, bo, ws, coeffs.data() + i * s);
             const JacobianBounds& b = ec.bounds;
-            if (b.jmax_upper > 0) ec.ratio_lower = std::nextafter(b.jmin_lower / b.jmax_upper, -INFINITY);
+            if (b.jmax_upper > 0) ec.ratio_lower = next_down(b.jmin_lower / b.jmax_upper);
             if (b.javg > 0) ec.jmin_over_javg = b.jmin_lower / b.javg;
             if (options.measure == CheckMeasure::distortion)
               ec.distortion = distortion_from(space, xe, report.planar, b, ws);

@@ -8,24 +8,31 @@
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/outward_rounding.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-double down(double x) { return std::nextafter(x, -kInf); }
-double up(double x) { return std::nextafter(x, kInf); }
+double down(double x) { return next_down(x); }
+double up(double x) { return next_up(x); }
 
-// Bézier coefficients of J from samples, and their error bound (see jacobian_bounds.hpp).
-double to_bezier_with_error(const BezierBasis& basis, const double* samples, double err,
-                            double* coeffs, std::vector<double>& scratch) {
+// Error bound of the Bézier coefficients computed from samples within err of J (see
+// jacobian_bounds.hpp): norm * (err + rounding * max|sample|), rounded up.
+double coefficient_error(const BezierBasis& basis, const double* samples, double err) {
   const auto s = static_cast<std::size_t>(basis.size());
-  scratch.resize(2 * s);
-  basis.to_bezier(samples, coeffs, scratch.data());
   double max_abs = 0;
   for (std::size_t k = 0; k < s; ++k) max_abs = std::max(max_abs, std::abs(samples[k]));
   return up(basis.to_bezier_norm() * (err + basis.to_bezier_rounding() * max_abs) * (1 + 1e-12));
+}
+
+// Bézier coefficients of J from samples, and their error bound.
+double to_bezier_with_error(const BezierBasis& basis, const double* samples, double err,
+                            double* coeffs, std::vector<double>& scratch) {
+  scratch.resize(2 * static_cast<std::size_t>(basis.size()));
+  basis.to_bezier(samples, coeffs, scratch.data());
+  return coefficient_error(basis, samples, err);
 }
 
 // a / b rounded toward -inf or +inf (b != 0).
@@ -52,7 +59,8 @@ bool jacobian_bounds_supported(const ElementType& type) noexcept {
 
 JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* samples,
                                    double err, const double* nodes, bool planar,
-                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws) {
+                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws,
+                                   const double* root_coeffs) {
   const BezierBasis& basis = space.basis();
   const auto s = static_cast<std::size_t>(basis.size());
   JacobianBounds out;
@@ -64,7 +72,13 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
 
   // Stage 1: the first Bézier coefficients (eq. 18).
   ws.coeffs.resize(s);
-  double err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
+  double err_b;
+  if (root_coeffs != nullptr) {
+    std::copy(root_coeffs, root_coeffs + s, ws.coeffs.begin());
+    err_b = coefficient_error(basis, samples, err);
+  } else {
+    err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
+  }
   const bool measuring = options.goal == BoundsGoal::measure;
   if (measuring || !sample_invalid) {
     double lo = kInf;

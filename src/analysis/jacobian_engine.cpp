@@ -13,6 +13,7 @@
 #include <queue>
 
 #include "bezier/bezier_exact.hpp"
+#include "analysis/outward_rounding.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -20,8 +21,8 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double down(double x) { return std::nextafter(x, -kInf); }
-double up(double x) { return std::nextafter(x, kInf); }
+double down(double x) { return next_down(x); }
+double up(double x) { return next_up(x); }
 
 // Min-heap on lower (std heap functions are max-heaps: invert the comparison).
 bool heap_less(const BoundsWorkspace::Impl::Leaf& a, const BoundsWorkspace::Impl::Leaf& b) {

@@ -64,9 +64,12 @@ ExactRefinement exact_validity(const BezierBasis& basis, std::vector<mpq_class> 
 /// exact fallback when rounding keeps the sign open).
 /// @param samples num_samples values of J, each within err of the exact one
 /// @param nodes   the element's #nodes x 3 coordinates (for the exact fallback)
+/// @param root_coeffs the samples' Bézier coefficients when already computed (batched
+///        BezierBasis::to_bezier_batch, bit-identical to to_bezier), else nullptr
 JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* samples,
                                    double err, const double* nodes, bool planar,
-                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws);
+                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws,
+                                   const double* root_coeffs = nullptr);
 
 /// Distortion bounds (see jacobian_bounds.hpp) of one element with bounds jb.
 DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,

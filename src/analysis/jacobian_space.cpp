@@ -307,6 +307,7 @@ bool jacobian_supported(const ElementType& type) noexcept {
 JacobianSpace::JacobianSpace(const ElementType& type)
     : type_(&type), basis_(&bezier_basis(type.family, type.order)) {
   QV_ASSERT(jacobian_supported(type), "no Jacobian space for " << type.name);
+  if (type.family == ElementFamily::pyramid) { init_pyramid(); return; }
   num_nodes_ = type.num_nodes;
   num_samples_ = basis_->size();
   dim_ = type.dim;

@@ -48,6 +48,7 @@ class JacobianSpace {
 
  private:
   void build_exact() const;
+  void init_pyramid();  // src/analysis/pyramid_space.cpp (Paper IV)
 
   const ElementType* type_;
   const BezierBasis* basis_;

@@ -1,5 +1,6 @@
 list(APPEND QUADVAL_SOURCES
   src/analysis/jacobian_space.cpp
+  src/analysis/pyramid_space.cpp
   src/analysis/jacobian_samples.cpp
   src/analysis/jacobian_engine.cpp
   src/analysis/jacobian_bounds.cpp

@@ -107,6 +107,15 @@ double nearest(const mpq_class& q) {
   return best;
 }
 
+// Transposes square blocks of size n*n.
+std::vector<double> transpose_blocks(const std::vector<double>& m, std::size_t n) {
+  std::vector<double> t(m.size());
+  for (std::size_t b = 0; b < m.size(); b += n * n)
+    for (std::size_t r = 0; r < n; ++r)
+      for (std::size_t c = 0; c < n; ++c) t[b + c * n + r] = m[b + r * n + c];
+  return t;
+}
+
 // Children of the midpoint subdivision, vertices as barycentric coordinates times 2.
 std::vector<std::array<MultiIndex, 4>> midpoint_children(int d) {
   const auto vertex = [](int a) {
@@ -237,9 +246,12 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
       }
     }
   }
+  to_bezier_t_ = transpose_blocks(to_bezier_, n_sz);
+  subdivision_t_ = transpose_blocks(subdivision_, n_sz);
 }
 
 BernsteinSimplex::~BernsteinSimplex() = default;
+
 
 std::array<double, 3> BernsteinSimplex::point(int i) const noexcept {
   const MultiIndex num = point_numerators(i);
@@ -278,6 +290,11 @@ void BernsteinSimplex::evaluate(std::span<const double> xi, std::span<double> va
     }
     values[static_cast<std::size_t>(i)] = b;
   }
+}
+
+std::span<const double> BernsteinSimplex::subdivision_transposed(int child) const noexcept {
+  const auto n = static_cast<std::size_t>(size()) * static_cast<std::size_t>(size());
+  return {subdivision_t_.data() + static_cast<std::size_t>(child) * n, n};
 }
 
 std::span<const double> BernsteinSimplex::subdivision(int child) const noexcept {

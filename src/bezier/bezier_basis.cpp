@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "bezier/pyramid_basis.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -26,6 +27,7 @@ std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int p) {
     case ElementFamily::tetrahedron: return {{3, 3 * (p - 1)}};
     case ElementFamily::prism: return {{2, 3 * p - 2}, {1, 3 * p - 1}};
     case ElementFamily::hexahedron: return {{1, 3 * p - 1}, {1, 3 * p - 1}, {1, 3 * p - 1}};
+    case ElementFamily::pyramid: return pyramid_jacobian_factor_degrees(p);  // Paper IV eq. 6
     default: return {};
   }
 }
@@ -42,6 +44,7 @@ int max_supported_order(ElementFamily family) noexcept {
     case ElementFamily::tetrahedron: return 4;
     case ElementFamily::prism:
     case ElementFamily::hexahedron: return 3;
+    case ElementFamily::pyramid: return kPyramidMaxOrder;
     default: return 0;
   }
 }
@@ -116,28 +119,41 @@ void BezierBasis::evaluate(std::span<const double> x, std::span<double> values) 
   }
 }
 
-// Applies matrix_of(f) (s_f x s_f, row-major) along axis f, for every factor in turn.
+// Applies matrix_of(f) (s_f x s_f, row-major) along axis f, for every factor in turn, to
+// `count` interleaved arrays (element index fastest). Every output entry is the sum over
+// j = 0 .. s_f - 1 in that order, whatever the loop nest, so results do not depend on
+// `count`. When the contiguous run is 1 (one element, first factor) the loop runs over
+// the output rows innermost with the transposed matrix, so that it vectorises.
 template <class MatrixOf>
 void BezierBasis::apply_factors(const double* in, double* out, double* scratch,
-                                MatrixOf matrix_of) const {
+                                std::size_t count, MatrixOf matrix_of) const {
   const std::size_t nf = factors_.size();
-  std::size_t stride = 1;
+  const std::size_t total = static_cast<std::size_t>(size_) * count;
+  std::size_t stride = count;
   const double* src = in;
   for (std::size_t f = 0; f < nf; ++f) {
     const std::size_t s = static_cast<std::size_t>(factors_[f]->size());
-    const std::size_t outer = static_cast<std::size_t>(size_) / (s * stride);
-    double* dst = (f + 1 == nf) ? out : scratch + (f % 2) * static_cast<std::size_t>(size_);
-    const double* m = matrix_of(f);
+    const std::size_t outer = total / (s * stride);
+    double* dst = (f + 1 == nf) ? out : scratch + (f % 2) * total;
+    const auto [m, mt] = matrix_of(f);  // row-major and its transpose
     for (std::size_t o = 0; o < outer; ++o) {
       const double* sblock = src + o * s * stride;
       double* dblock = dst + o * s * stride;
+      if (stride == 1) {
+        for (std::size_t a = 0; a < s; ++a) dblock[a] = 0;
+        for (std::size_t j = 0; j < s; ++j) {
+          const double v = sblock[j];
+          const double* col = mt + j * s;  // column j of the matrix
+          for (std::size_t a = 0; a < s; ++a) dblock[a] += col[a] * v;
+        }
+        continue;
+      }
       for (std::size_t a = 0; a < s; ++a) {
         const double* row = m + a * s;
         double* d = dblock + a * stride;
         for (std::size_t i = 0; i < stride; ++i) d[i] = 0;
         for (std::size_t j = 0; j < s; ++j) {
           const double w = row[j];
-          if (w == 0) continue;
           const double* sv = sblock + j * stride;
           for (std::size_t i = 0; i < stride; ++i) d[i] += w * sv[i];
         }
@@ -149,15 +165,23 @@ void BezierBasis::apply_factors(const double* in, double* out, double* scratch,
 }
 
 void BezierBasis::to_bezier(const double* samples, double* coeffs, double* scratch) const {
-  apply_factors(samples, coeffs, scratch,
-                [this](std::size_t f) { return factors_[f]->lagrange_to_bezier().data(); });
+  to_bezier_batch(samples, 1, coeffs, scratch);
+}
+
+void BezierBasis::to_bezier_batch(const double* samples, std::size_t count, double* coeffs,
+                                  double* scratch) const {
+  apply_factors(samples, coeffs, scratch, count, [this](std::size_t f) {
+    return std::pair{factors_[f]->lagrange_to_bezier().data(),
+                     factors_[f]->lagrange_to_bezier_transposed().data()};
+  });
 }
 
 void BezierBasis::subdivide(int child, const double* parent, double* out,
                             double* scratch) const {
   const std::array<int, 3> digits = child_digits(child);
-  apply_factors(parent, out, scratch, [this, &digits](std::size_t f) {
-    return factors_[f]->subdivision(digits[f]).data();
+  apply_factors(parent, out, scratch, 1, [this, &digits](std::size_t f) {
+    return std::pair{factors_[f]->subdivision(digits[f]).data(),
+                     factors_[f]->subdivision_transposed(digits[f]).data()};
   });
 }
 

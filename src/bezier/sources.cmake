@@ -1,4 +1,5 @@
 list(APPEND QUADVAL_SOURCES
   src/bezier/bernstein_simplex.cpp
   src/bezier/bezier_basis.cpp
+  src/bezier/pyramid_basis.cpp
 )

@@ -249,7 +249,8 @@ LookaheadOutcome lookahead_run(const LookaheadGraph& g, const LookaheadOptions& 
   LookaheadOutcome out;
   out.pairs = s.applied();
   out.run.seed = seed;
-  out.run.quality = s.quality();
+  // Summed afresh: the state's running sum carries the rounding of every apply/undo.
+  for (std::uint32_t p : out.pairs) out.run.quality += g.reward[p];
   out.run.quads = s.quads();
   out.run.triangles_left = g.num_triangles - 2 * s.quads();
   out.run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "dual_graph.hpp"
+#include "lookahead_matching.hpp"
 #include "matching.hpp"
 #include "mixed_mesh.hpp"
 #include "quad_cleanup.hpp"
@@ -162,7 +163,8 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
     throw InputError::in_file(
         options.source, fmt::format("the cross field has {} angles for {} triangles",
                                     options.cross_field_per_triangle.size(), s.triangles.size()));
-  if (options.algorithm == RecombineAlgorithm::blossom &&
+  if ((options.algorithm == RecombineAlgorithm::blossom ||
+       options.algorithm == RecombineAlgorithm::lookahead) &&
       options.odd_policy == OddPolicy::split_boundary_edge)
     make_regions_even(s);
   stats.odd_splits = s.odd_splits;
@@ -194,10 +196,14 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
 
   const Matching match = options.algorithm == RecombineAlgorithm::blossom
                              ? blossom_matching(graph)
+                             : options.algorithm == RecombineAlgorithm::lookahead
+                             ? lookahead_matching(graph, s, options, stats)
                              : greedy_matching(graph);
   stats.perfect_matching = match.perfect;
   stats.matching_cost = match.cost;
-  timer.stage(options.algorithm == RecombineAlgorithm::blossom ? "blossom" : "greedy",
+  timer.stage(options.algorithm == RecombineAlgorithm::blossom     ? "blossom"
+              : options.algorithm == RecombineAlgorithm::lookahead ? "lookahead"
+                                                                   : "greedy",
               fmt::format("{} pairs{}, cost {:.6g}", match.pairs.size(),
                           match.perfect ? " (perfect)" : " (not perfect)", match.cost));
   if (!match.perfect && options.algorithm == RecombineAlgorithm::blossom)

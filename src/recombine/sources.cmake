@@ -12,6 +12,7 @@ list(APPEND QUADVAL_SOURCES
   src/recombine/recombine.cpp
   src/recombine/lookahead_state.cpp
   src/recombine/lookahead_tree.cpp
+  src/recombine/lookahead_matching.cpp
 )
 list(APPEND QUADVAL_SOURCES src/recombine/lemon_matching.cpp)
 # LEMON 1.3 calls std::allocator::construct/destroy, removed in C++20: this one file is C++17.

@@ -3,4 +3,5 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/jacobian_exact_test.cpp
   analysis/gmsh_agreement_test.cpp
   analysis/check_cli_test.cpp
+  analysis/pyramid_jacobian_test.cpp
 )

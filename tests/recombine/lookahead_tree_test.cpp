@@ -89,9 +89,20 @@ Optimum oracle_optimum(const test::LookaheadFixture& f) {
   return best((std::uint64_t{1} << g.num_triangles) - 1);
 }
 
+// Positive rewards all distinct (non-convex quads score 0: ties there are allowed).
 bool distinct_rewards(const LookaheadGraph& g) {
-  std::set<double> r(g.reward.begin(), g.reward.end());
-  return r.size() == g.reward.size() && *r.begin() > 0.0;
+  std::set<double> r;
+  std::size_t positive = 0;
+  for (double x : g.reward)
+    if (x > 0) r.insert(x), ++positive;
+  return r.size() == positive;
+}
+
+// Once the best allowed reward is 0 it stays 0 (allowed sets only shrink), and the order
+// among zero-reward pairs is a tie-break: compare the sequences without their zero tail.
+std::vector<std::uint32_t> positive_prefix(const LookaheadGraph& g, std::vector<std::uint32_t> s) {
+  while (!s.empty() && g.reward[s.back()] == 0.0) s.pop_back();
+  return s;
 }
 
 TEST(LookaheadTree, UniformHorizonOneIsGreedyWithTheCriterion) {
@@ -105,7 +116,8 @@ TEST(LookaheadTree, UniformHorizonOneIsGreedyWithTheCriterion) {
     o.tree = LookaheadTree::uniform;
     o.horizon = 1;
     const auto fast = lookahead_run(f.graph, o, seed);
-    EXPECT_EQ(fast.pairs, oracle_greedy(f)) << "seed " << seed;
+    const auto want = oracle_greedy(f);
+    EXPECT_EQ(positive_prefix(f.graph, fast.pairs), positive_prefix(f.graph, want)) << "seed " << seed;
     expect_valid_sequence(f, fast.pairs);
     ++compared;
   }
@@ -124,16 +136,16 @@ TEST(LookaheadTree, FullHorizonFindsTheBruteForceOptimum) {
     uniform.tree = LookaheadTree::uniform;
     uniform.horizon = full;
     const auto u = lookahead_run(f.graph, uniform, seed);
-    EXPECT_NEAR(u.run.quality, want.any, 1e-12) << "seed " << seed;
+    EXPECT_NEAR(u.run.quality, want.any, 1e-9) << "seed " << seed;
     expect_valid_sequence(f, u.pairs);
     // §5: when the optimum merges every triangle, the selective tree at full depth holds it.
     LookaheadOptions selective;
     selective.horizon = full;
     const auto s = lookahead_run(f.graph, selective, seed);
     expect_valid_sequence(f, s.pairs);
-    EXPECT_LE(s.run.quality, want.any + 1e-12);
+    EXPECT_LE(s.run.quality, want.any + 1e-9);
     if (want.perfect >= 0) {
-      EXPECT_GE(s.run.quality, want.perfect - 1e-12) << "seed " << seed;
+      EXPECT_GE(s.run.quality, want.perfect - 1e-9) << "seed " << seed;
       ++perfect;
     }
     ++compared;

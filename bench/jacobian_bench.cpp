@@ -1,0 +1,121 @@
+// Throughput of the certified Jacobian check (check_mesh, validity) on structured meshes
+// built in memory: linear hexahedra with perturbed nodes, and third-order tetrahedra
+// (6 Kuhn tetrahedra per cube) with every lattice node perturbed, so all are curved.
+//
+//   build-jac/bench/quadval_bench --benchmark_filter=Check
+// Counters: elements/s (wall), and the answers so a regression in them shows.
+#include <benchmark/benchmark.h>
+
+#include <array>
+#include <random>
+
+#include "quadval/check_report.hpp"
+#include "quadval/lagrange_basis.hpp"
+
+namespace quadval {
+namespace {
+
+// (n+1)^3 nodes on a unit-spaced lattice, perturbed by up to `amp`.
+Mesh linear_hexes(int n, double amp) {
+  Mesh m;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-amp, amp);
+  const auto id = [n](int i, int j, int k) { return static_cast<NodeIndex>(i + (n + 1) * (j + (n + 1) * k)); };
+  for (int k = 0; k <= n; ++k)
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        m.node_tags.push_back(m.node_tags.size() + 1);
+        m.coords.insert(m.coords.end(), {i + u(rng), j + u(rng), k + u(rng)});
+      }
+  ElementBlock b;
+  b.type = find_element_type(5);
+  b.entity_dim = 3;
+  b.entity_tag = 1;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        b.tags.push_back(b.tags.size() + 1);
+        b.nodes.insert(b.nodes.end(), {id(i, j, k), id(i + 1, j, k), id(i + 1, j + 1, k), id(i, j + 1, k),
+                                       id(i, j, k + 1), id(i + 1, j, k + 1), id(i + 1, j + 1, k + 1),
+                                       id(i, j + 1, k + 1)});
+      }
+  m.blocks.push_back(std::move(b));
+  return m;
+}
+
+// 6 n^3 order-p tetrahedra; nodes on the lattice of step 1/p, all perturbed by up to amp/p.
+Mesh curved_tets(int n, int p, double amp) {
+  Mesh m;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-amp / p, amp / p);
+  const int L = p * n + 1;
+  for (int k = 0; k < L; ++k)
+    for (int j = 0; j < L; ++j)
+      for (int i = 0; i < L; ++i) {
+        m.node_tags.push_back(m.node_tags.size() + 1);
+        m.coords.insert(m.coords.end(), {double(i) / p + u(rng), double(j) / p + u(rng), double(k) / p + u(rng)});
+      }
+  const ElementType& type = *find_element_type(ElementFamily::tetrahedron, p, true);
+  const auto ref = reference_nodes(type);
+  // Kuhn subdivision of the unit cube: paths 0 -> 7 through the cube corners.
+  static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  ElementBlock b;
+  b.type = &type;
+  b.entity_dim = 3;
+  b.entity_tag = 1;
+  for (int ck = 0; ck < n; ++ck)
+    for (int cj = 0; cj < n; ++cj)
+      for (int ci = 0; ci < n; ++ci)
+        for (const auto& perm : kPerm) {
+          std::array<std::array<int, 3>, 4> v{};  // tet vertices, in lattice cells
+          v[0] = {0, 0, 0};
+          for (int s = 0; s < 3; ++s) {
+            v[static_cast<std::size_t>(s + 1)] = v[static_cast<std::size_t>(s)];
+            v[static_cast<std::size_t>(s + 1)][static_cast<std::size_t>(perm[s])] = 1;
+          }
+          b.tags.push_back(b.tags.size() + 1);
+          for (const auto& r : ref) {
+            const double lam[4] = {1 - r[0] - r[1] - r[2], r[0], r[1], r[2]};
+            int q[3];
+            for (int a = 0; a < 3; ++a) {
+              double x = 0;
+              for (int c = 0; c < 4; ++c) x += lam[c] * v[static_cast<std::size_t>(c)][static_cast<std::size_t>(a)];
+              q[a] = static_cast<int>(std::lround(x * p)) + p * (a == 0 ? ci : a == 1 ? cj : ck);
+            }
+            b.nodes.push_back(static_cast<NodeIndex>(q[0] + L * (q[1] + L * q[2])));
+          }
+        }
+  m.blocks.push_back(std::move(b));
+  return m;
+}
+
+void run(benchmark::State& state, const Mesh& mesh) {
+  CheckOptions o;
+  o.threads = static_cast<int>(state.range(1));
+  CheckReport r;
+  for (auto _ : state) {
+    r = check_mesh(mesh, o);
+    benchmark::DoNotOptimize(r.elements.data());
+  }
+  state.counters["elements/s"] =
+      benchmark::Counter(static_cast<double>(mesh.num_elements()), benchmark::Counter::kIsIterationInvariantRate);
+  state.counters["valid"] = static_cast<double>(r.count(Validity::valid));
+  state.counters["invalid"] = static_cast<double>(r.count(Validity::invalid));
+  state.counters["undetermined"] = static_cast<double>(r.count(Validity::undetermined));
+}
+
+void BM_CheckLinearHex(benchmark::State& state) {
+  static const Mesh mesh = linear_hexes(static_cast<int>(state.range(0)), 0.2);
+  run(state, mesh);
+}
+BENCHMARK(BM_CheckLinearHex)->Args({100, 1})->Args({100, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CheckCurvedTetP3(benchmark::State& state) {
+  static const Mesh mesh = curved_tets(static_cast<int>(state.range(0)), 3, 0.15);
+  run(state, mesh);
+}
+// 6 * 55^3 = 998,250 tetrahedra
+BENCHMARK(BM_CheckCurvedTetP3)->Args({55, 1})->Args({55, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace quadval

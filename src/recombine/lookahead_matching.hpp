@@ -1,0 +1,23 @@
+#pragma once
+// The look-ahead tree (Paper II) as a step of the recombine() pipeline: it returns the merged
+// pairs as a Matching of the dual graph, so that the rest of the pipeline (mixed mesh,
+// optimisation, the full-quad refinement of leftover triangles, statistics) is shared with
+// Blossom-Quad.
+
+#include "dual_graph.hpp"
+#include "matching.hpp"
+#include "quadval/recombine.hpp"
+#include "triangle_input.hpp"
+
+namespace quadval::recombine_detail {
+
+/// Best of options.lookahead.runs runs on the real pairs of `graph` (built without extra
+/// pairs). Fills the lookahead_* statistics; with options.compare_with_blossom also the
+/// Blossom optimum on the same pairs (blossom_matching) and the percentage.
+/// @throws InputError (naming options.source) when a connected set of triangles has an odd
+///         count: the criterion needs even polder sets (OddPolicy::split_boundary_edge fixes
+///         odd regions; a region made of several odd pieces cannot be fixed that way).
+Matching lookahead_matching(const DualGraph& graph, const TriangleSurface& s,
+                            const RecombineOptions& options, RecombineStats& stats);
+
+}  // namespace quadval::recombine_detail
