@@ -33,12 +33,16 @@
 ///
 /// VTU (write only): VTK XML UnstructuredGrid, file version 2.2 (the current Lagrange
 /// hexahedron edge order), appended raw binary data. Linear cells use the classical VTK
-/// types, complete higher-order cells the VTK Lagrange types 68-74 with nodes permuted
-/// into VTK's order, the serendipity types Quadrilateral 8, Hexahedron 20, Prism 15 and
-/// Pyramid 13 the VTK quadratic types 23, 25, 26, 27. Types with no VTK cell (higher-order
-/// incomplete types, bubble and border elements) are written as their corner-only linear
-/// cell, with a warning on stderr. Per-element fields become CellData, beside the
-/// "element_tag" and "entity_tag" arrays written always.
+/// types (1, 3, 5, 9, 10, 12, 13, 14), complete higher-order lines, triangles, quadrangles,
+/// tetrahedra, hexahedra and prisms the VTK Lagrange types 68-73 with nodes permuted into
+/// VTK's order, the serendipity types Quadrilateral 8, Hexahedron 20, Prism 15 and
+/// Pyramid 13 the VTK quadratic types 23, 25, 26, 27. VTK (9.1, installed here) has no
+/// Lagrange pyramid (type 74 is not implemented), so Pyramid 14 becomes type 27 without
+/// its base centre node and higher-order pyramids their linear pyramid. Other types with
+/// no VTK cell (incomplete types of order >= 3, bubble, border and Xfem elements) are
+/// written as their corner-only linear cell; one-node order-0 types and the trihedron as a
+/// VTK_POLY_VERTEX. Each lossy case prints one warning per block on stderr. Per-element
+/// fields become CellData, beside the "element_tag" and "entity_tag" arrays written always.
 ///
 /// Surfaces (read only): STL (ASCII or binary; vertices with identical coordinates are
 /// merged), OBJ (v / f lines; indices may be negative or carry /vt/vn parts), OFF. Faces

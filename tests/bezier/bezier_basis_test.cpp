@@ -235,7 +235,7 @@ TEST(BezierBasis, SizesFollowTable1) {
     EXPECT_EQ(bezier_basis(ElementFamily::prism, p).vertex_indices().size(), 6u);
     EXPECT_EQ(bezier_basis(ElementFamily::quadrangle, p).vertex_indices().size(), 4u);
   }
-  EXPECT_THROW(bezier_basis(ElementFamily::pyramid, 1), std::invalid_argument);
+  EXPECT_THROW(bezier_basis(ElementFamily::polygon, 1), std::invalid_argument);
   EXPECT_THROW(bezier_basis(ElementFamily::hexahedron, 0), std::invalid_argument);
 }
 

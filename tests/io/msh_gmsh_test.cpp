@@ -160,3 +160,60 @@ TEST(MshGmsh, WeReadTheSharedDataAsGmshDoes) {
 
 }  // namespace
 }  // namespace quadval
+
+namespace quadval {
+namespace {
+
+/// (element tag) -> (type, node tags), for comparing meshes whose blocks may be ordered
+/// differently.
+std::map<Tag, std::pair<int, std::vector<Tag>>> elements_by_tag(const Mesh& m) {
+  std::map<Tag, std::pair<int, std::vector<Tag>>> out;
+  for (const ElementBlock& b : m.blocks)
+    for (std::size_t e = 0; e < b.size(); ++e) {
+      std::vector<Tag> nodes;
+      for (NodeIndex v : b.element(e)) nodes.push_back(m.node_tags[v]);
+      out[b.tags[e]] = {b.type->gmsh_id, nodes};
+    }
+  return out;
+}
+
+std::map<Tag, std::array<double, 3>> nodes_by_tag(const Mesh& m) {
+  std::map<Tag, std::array<double, 3>> out;
+  for (std::size_t i = 0; i < m.num_nodes(); ++i) out[m.node_tags[i]] = m.node(static_cast<NodeIndex>(i));
+  return out;
+}
+
+// Files Gmsh itself writes in binary read exactly as the ASCII files it writes, and both
+// hold the nodes and elements of the original.
+TEST(MshGmsh, WeReadWhatGmshWritesInEveryEncoding) {
+  ScratchDir dir("gmsh_writes");
+  const std::filesystem::path data = std::filesystem::path(QUADVAL_SHARED_DIR) / "data";
+  for (const char* name : {"curved/mixed_h0.6_o2.msh", "curved/quad_h0.4_o2.msh", "tri/rect-sin-a6.msh"}) {
+    SCOPED_TRACE(name);
+    const Mesh original = read_mesh(data / name);
+    std::map<std::string, Mesh> by_encoding;
+    for (const char* version : {"4.1", "2.2"}) {
+      for (const char* binary : {"0", "1"}) {
+        const auto out = dir / fmt::format("g_{}_{}.msh", version, binary);
+        const int status = std::system(fmt::format("{} {}/tests/io/gmsh_convert.py {} {} {} {} 2>{}", QUADVAL_PYTHON,
+                                                   QUADVAL_SOURCE_DIR, (data / name).string(), out.string(), version,
+                                                   binary, (dir / "err.txt").string()).c_str());
+        const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+        if (code == 77) GTEST_SKIP() << testing_io::file_bytes(dir / "err.txt");
+        ASSERT_EQ(code, 0) << testing_io::file_bytes(dir / "err.txt");
+        std::vector<std::string> warnings;
+        by_encoding[fmt::format("{}_{}", version, binary)] = read_mesh(out, &warnings);
+      }
+    }
+    EXPECT_TRUE(by_encoding["4.1_1"] == by_encoding["4.1_0"]);
+    EXPECT_TRUE(by_encoding["2.2_1"] == by_encoding["2.2_0"]);
+    for (const auto& [encoding, m] : by_encoding) {
+      SCOPED_TRACE(encoding);
+      EXPECT_EQ(nodes_by_tag(m), nodes_by_tag(original));
+      EXPECT_EQ(elements_by_tag(m), elements_by_tag(original));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace quadval

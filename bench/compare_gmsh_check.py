@@ -1,0 +1,97 @@
+#!/usr/bin/python3
+"""Side by side: `quadval check` (certified Jacobian bounds, validity) and Gmsh 4.8.4's
+AnalyseMeshQuality plugin (Jacobian only, via ../shared/data/tools/gmsh_analyse.py) on the
+same files. Prints, per mesh: elements, invalid counts of both, the analysis time of each
+(quadval: its own timer around the analysis; Gmsh: the plugin's wall time around
+gmsh.plugin.run), elements per second, the ratio, and each process's peak memory.
+
+    /usr/bin/python3 bench/compare_gmsh_check.py --quadval build/quadval
+    /usr/bin/python3 bench/compare_gmsh_check.py --quadval build/quadval --hex-box 100 --threads 2
+
+--hex-box N also writes (and caches under /tmp/quadval_check_bench/) an N^3 box of linear
+hexahedra with perturbed nodes, MSH 4.1, to measure throughput on a large mesh.
+"""
+import argparse
+import glob
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SHARED = os.path.join(HERE, "..", "..", "shared", "data")
+CACHE = "/tmp/quadval_check_bench"
+
+
+def run_measured(cmd):
+    """Runs cmd, returns (exit code, stdout, peak RSS in MiB of that process)."""
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
+    out = p.stdout.read()
+    _, status, usage = os.wait4(p.pid, 0)
+    p.returncode = os.waitstatus_to_exitcode(status)
+    return p.returncode, out.decode(errors="replace"), usage.ru_maxrss / 1024.0
+
+
+def hex_box(n, amp=0.2, seed=3):
+    path = os.path.join(CACHE, "hex_box_%d.msh" % n)
+    if os.path.exists(path):
+        return path
+    os.makedirs(CACHE, exist_ok=True)
+    rng = np.random.default_rng(seed)
+    g = np.arange(n + 1, dtype=float)
+    z, y, x = np.meshgrid(g, g, g, indexing="ij")
+    xyz = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1) + rng.uniform(-amp, amp, ((n + 1) ** 3, 3))
+    idx = np.arange((n + 1) ** 3).reshape(n + 1, n + 1, n + 1)  # [k, j, i]
+    c = idx[:-1, :-1, :-1].ravel()
+    di, dj, dk = 1, n + 1, (n + 1) ** 2
+    hexes = np.stack([c, c + di, c + di + dj, c + dj, c + dk, c + di + dk, c + di + dj + dk, c + dj + dk], axis=1) + 1
+    nn, ne = len(xyz), len(hexes)
+    with open(path, "w") as f:
+        f.write("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n")
+        f.write("$Nodes\n1 %d 1 %d\n3 1 0 %d\n" % (nn, nn, nn))
+        np.savetxt(f, np.arange(1, nn + 1), fmt="%d")
+        np.savetxt(f, xyz, fmt="%.17g")
+        f.write("$EndNodes\n$Elements\n1 %d 1 %d\n3 1 5 %d\n" % (ne, ne, ne))
+        np.savetxt(f, np.column_stack([np.arange(1, ne + 1), hexes]), fmt="%d")
+        f.write("$EndElements\n")
+    return path
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quadval", default=os.path.join(HERE, "..", "build", "quadval"))
+    ap.add_argument("--threads", type=int, default=0)
+    ap.add_argument("--hex-box", type=int, nargs="*", default=[])
+    ap.add_argument("--meshes", nargs="*", default=None)
+    a = ap.parse_args()
+    meshes = a.meshes or sorted(glob.glob(os.path.join(SHARED, "curved", "*.msh")))
+    meshes += [hex_box(n) for n in a.hex_box]
+    tool = os.path.join(SHARED, "tools", "gmsh_analyse.py")
+    hdr = "%-36s %9s %8s %8s %10s %10s %12s %12s %8s %9s %9s" % (
+        "mesh", "elements", "inv(q)", "inv(g)", "t_q [s]", "t_g [s]", "el/s quadval", "el/s gmsh", "ratio",
+        "MiB(q)", "MiB(g)")
+    print(hdr)
+    print("-" * len(hdr))
+    with tempfile.TemporaryDirectory() as tmp:
+        for m in meshes:
+            qjson = os.path.join(tmp, "q.json")
+            rc, _, mem_q = run_measured([a.quadval, "check", m, "-q", "--threads", str(a.threads), "-o", qjson])
+            if rc not in (0, 1):
+                print("%-36s quadval failed (exit %d)" % (os.path.basename(m), rc))
+                continue
+            q = json.load(open(qjson))["summary"]
+            gjson = os.path.join(tmp, "g.json")
+            rc, _, mem_g = run_measured([sys.executable, tool, m, "--measures", "J", "--json", gjson, "--quiet"])
+            g = json.load(open(gjson))
+            n = q["elements"]
+            tq, tg = q["seconds"], g["t_plugin_run_s"]
+            print("%-36s %9d %8d %8d %10.4f %10.4f %12.3g %12.3g %8.1f %9.0f %9.0f" % (
+                os.path.basename(m)[:36], n, q["invalid"], g["n_invalid_ratio_le_0"], tq, tg, n / tq, n / tg,
+                tg / tq, mem_q, mem_g))
+
+
+if __name__ == "__main__":
+    main()
