@@ -27,12 +27,13 @@ CACHE = "/tmp/quadval_check_bench"
 
 
 def run_measured(cmd):
-    """Runs cmd, returns (exit code, stdout, peak RSS in MiB of that process)."""
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL)
-    out = p.stdout.read()
-    _, status, usage = os.wait4(p.pid, 0)
-    p.returncode = os.waitstatus_to_exitcode(status)
-    return p.returncode, out.decode(errors="replace"), usage.ru_maxrss / 1024.0
+    """Runs cmd under /usr/bin/time; returns (exit code, stdout, peak RSS in MiB of that
+    process). (os.wait4's ru_maxrss would count the memory of this Python process at fork.)"""
+    with tempfile.NamedTemporaryFile("r", suffix=".time") as t:
+        p = subprocess.run(["/usr/bin/time", "-f", "%M", "-o", t.name] + cmd, stdout=subprocess.PIPE,
+                           stderr=subprocess.DEVNULL)
+        kib = float(open(t.name).read().strip().splitlines()[-1])
+    return p.returncode, p.stdout.decode(errors="replace"), kib / 1024.0
 
 
 def hex_box(n, amp=0.2, seed=3):

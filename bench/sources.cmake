@@ -3,4 +3,5 @@ list(APPEND QUADVAL_BENCH_SOURCES
   io_bench.cpp
   pyramid_bench.cpp
   jacobian_bench.cpp
+  lookahead_bench.cpp
 )

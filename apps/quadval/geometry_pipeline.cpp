@@ -89,11 +89,6 @@ int run_geometry_pipeline(const Triangulation& tri, const PipelineSettings& sett
   auto log = [&](const std::string& line) {
     if (!settings.quiet) fmt::print(stderr, "{}\n", line);
   };
-  if (settings.recombine == "lookahead")
-    throw InputError::in_file(settings.source,
-                              "the look-ahead recombination (Paper II) is not in this build; use "
-                              "--recombine blossom, greedy or none");
-
   // Triangle stage.
   log(fmt::format("[triangles] {} triangles, {} nodes, {}/{} curves with an odd number of "
                   "interior nodes, {:.3f} s",
@@ -120,8 +115,9 @@ int run_geometry_pipeline(const Triangulation& tri, const PipelineSettings& sett
   double quad_tau = 0;
   if (settings.recombine != "none") {
     RecombineOptions options;
-    options.algorithm = settings.recombine == "greedy" ? RecombineAlgorithm::greedy
-                                                       : RecombineAlgorithm::blossom;
+    options.algorithm = settings.recombine == "greedy"      ? RecombineAlgorithm::greedy
+                        : settings.recombine == "lookahead" ? RecombineAlgorithm::lookahead
+                                                            : RecombineAlgorithm::blossom;
     options.source = settings.source;
     if (settings.size)
       options.size_field = [h = *settings.size](double x, double y, double z) { return h(x, y, z); };

@@ -34,7 +34,7 @@ struct PipelineOutputs {
 /// the statistics table (triangle stage and quad stage) and returns the exit code: 0, or 1
 /// when the recombination left triangles although an all-quad mesh was asked for (blossom).
 /// `report_extra` is merged into the JSON report (e.g. the demo's name and parameters).
-/// @throws InputError for "lookahead" (not in this build) and for unwritable outputs.
+/// @throws InputError for unwritable outputs (and what recombine() throws).
 int run_geometry_pipeline(const Triangulation& triangles, const PipelineSettings& settings,
                           const PipelineOutputs& outputs, nlohmann::json report_extra = {});
 

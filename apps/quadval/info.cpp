@@ -99,7 +99,9 @@ void print_text(const std::string& path, const nlohmann::json& d) {
     const auto& t = d["triangles"];
     const bool even = t["even"].get<bool>();
     fmt::print("  triangles {} ({}){}\n", t["count"].get<std::size_t>(), even ? "even" : "odd",
-               even ? "" : ": no perfect matching exists, recombination leaves one triangle");
+               even ? ""
+                    : ": no perfect matching exists; `quadval recombine` splits a boundary "
+                      "edge first (--odd split) or leaves one triangle (--odd leave)");
     fmt::print("    edges {}, boundary edges {}, boundary loops {}\n",
                t["edges"].get<std::size_t>(), t["boundary_edges"].get<std::size_t>(),
                t["boundary_loops"].get<std::size_t>());

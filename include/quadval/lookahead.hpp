@@ -40,6 +40,9 @@ struct LookaheadRun {
   std::size_t quads = 0;              ///< merges made
   std::size_t triangles_left = 0;     ///< triangles never merged
   double seconds = 0.0;
+  /// Triangles visited by the parity searches of the criterion (a cost figure: it should
+  /// grow linearly with the mesh).
+  std::uint64_t search_steps = 0;
 };
 
 }  // namespace quadval

@@ -47,7 +47,8 @@ Matching lookahead_matching(const DualGraph& graph, const TriangleSurface& s,
     throw InputError::in_file(
         options.source,
         fmt::format("{} connected set(s) of triangles have an odd count; the look-ahead "
-                    "criterion (Paper II, Definition 2) needs even ones",
+                    "criterion (Paper II, Definition 2) needs even ones (use the odd policy "
+                    "that splits a boundary edge; a closed odd piece cannot be fixed)",
                     odd));
   const LookaheadBest best = lookahead_best_of(g, o);
   Matching m;

@@ -15,8 +15,9 @@ namespace quadval::recombine_detail {
 /// pairs). Fills the lookahead_* statistics; with options.compare_with_blossom also the
 /// Blossom optimum on the same pairs (blossom_matching) and the percentage.
 /// @throws InputError (naming options.source) when a connected set of triangles has an odd
-///         count: the criterion needs even polder sets (OddPolicy::split_boundary_edge fixes
-///         odd regions; a region made of several odd pieces cannot be fixed that way).
+///         count: the criterion needs even polder sets. OddPolicy::split_boundary_edge
+///         (make_pieces_even) fixes every odd piece that has a boundary edge; this is left for
+///         OddPolicy::leave_triangle and for odd pieces without a boundary edge.
 Matching lookahead_matching(const DualGraph& graph, const TriangleSurface& s,
                             const RecombineOptions& options, RecombineStats& stats);
 

@@ -253,6 +253,7 @@ LookaheadOutcome lookahead_run(const LookaheadGraph& g, const LookaheadOptions& 
   for (std::uint32_t p : out.pairs) out.run.quality += g.reward[p];
   out.run.quads = s.quads();
   out.run.triangles_left = g.num_triangles - 2 * s.quads();
+  out.run.search_steps = s.search_steps();
   out.run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

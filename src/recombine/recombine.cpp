@@ -10,6 +10,7 @@
 
 #include "dual_graph.hpp"
 #include "lookahead_matching.hpp"
+#include "lookahead_parity.hpp"
 #include "matching.hpp"
 #include "mixed_mesh.hpp"
 #include "quad_cleanup.hpp"
@@ -163,10 +164,11 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
     throw InputError::in_file(
         options.source, fmt::format("the cross field has {} angles for {} triangles",
                                     options.cross_field_per_triangle.size(), s.triangles.size()));
-  if ((options.algorithm == RecombineAlgorithm::blossom ||
-       options.algorithm == RecombineAlgorithm::lookahead) &&
-      options.odd_policy == OddPolicy::split_boundary_edge)
-    make_regions_even(s);
+  if (options.odd_policy == OddPolicy::split_boundary_edge) {
+    // The look-ahead criterion needs every connected piece even, not only every region.
+    if (options.algorithm == RecombineAlgorithm::blossom) make_regions_even(s);
+    if (options.algorithm == RecombineAlgorithm::lookahead) make_pieces_even(s);
+  }
   stats.odd_splits = s.odd_splits;
   if (s.odd_splits > 0)
     result.warnings.push_back(fmt::format(

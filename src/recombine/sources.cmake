@@ -13,6 +13,7 @@ list(APPEND QUADVAL_SOURCES
   src/recombine/lookahead_state.cpp
   src/recombine/lookahead_tree.cpp
   src/recombine/lookahead_matching.cpp
+  src/recombine/lookahead_parity.cpp
 )
 list(APPEND QUADVAL_SOURCES src/recombine/lemon_matching.cpp)
 # LEMON 1.3 calls std::allocator::construct/destroy, removed in C++20: this one file is C++17.

@@ -143,13 +143,13 @@ TEST(PyramidJacobian, DenseSamplingNeverBelowTheLowerBound) {
   int total = 0, valid = 0, invalid = 0, loose = 0;
   for (const ElementType* type : pyramid_types(kPyramidMaxOrder)) {
     SCOPED_TRACE(std::string(type->name));
-    const int count = type->order <= 2 ? 800 : type->order == 3 ? 150 : 40;
+    const int count = type->order <= 2 ? 700 : type->order == 3 ? 40 : 10;
     const auto pts = pyramid_points(type->order <= 2 ? 6 : 4, 40, rng);
     BoundsWorkspace ws;
     BoundsOptions opt;
     opt.goal = BoundsGoal::measure;
     opt.rel_tol = 1e-3;
-    opt.max_subdivisions = 4000;
+    opt.max_subdivisions = type->order <= 2 ? 4000 : 100;
     for (int e = 0; e < count; ++e) {
       const double amplitude = 0.05 + 0.3 * (e % 5) / 4.0;
       const auto x = test::random_element(*type, amplitude, rng);

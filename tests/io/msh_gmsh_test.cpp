@@ -5,7 +5,9 @@
 
 #include <cstdlib>
 #include <iostream>
+#include <cmath>
 #include <map>
+#include <set>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -177,6 +179,12 @@ std::map<Tag, std::pair<int, std::vector<Tag>>> elements_by_tag(const Mesh& m) {
   return out;
 }
 
+std::multiset<std::pair<int, std::vector<Tag>>> element_multiset(const Mesh& m) {
+  std::multiset<std::pair<int, std::vector<Tag>>> out;
+  for (const auto& [tag, element] : elements_by_tag(m)) out.insert(element);
+  return out;
+}
+
 std::map<Tag, std::array<double, 3>> nodes_by_tag(const Mesh& m) {
   std::map<Tag, std::array<double, 3>> out;
   for (std::size_t i = 0; i < m.num_nodes(); ++i) out[m.node_tags[i]] = m.node(static_cast<NodeIndex>(i));
@@ -205,12 +213,26 @@ TEST(MshGmsh, WeReadWhatGmshWritesInEveryEncoding) {
         by_encoding[fmt::format("{}_{}", version, binary)] = read_mesh(out, &warnings);
       }
     }
-    EXPECT_TRUE(by_encoding["4.1_1"] == by_encoding["4.1_0"]);
+    // Gmsh prints entity boxes with 16 significant digits in ASCII, which need not give back
+    // the double its binary files hold: boxes agree to rounding, everything else exactly.
+    Mesh binary41 = by_encoding["4.1_1"];
+    const Mesh& ascii41 = by_encoding["4.1_0"];
+    ASSERT_EQ(binary41.entities.size(), ascii41.entities.size());
+    for (std::size_t i = 0; i < ascii41.entities.size(); ++i)
+      for (int k = 0; k < 6; ++k) {
+        EXPECT_NEAR(binary41.entities[i].box[k], ascii41.entities[i].box[k], 1e-15 * (1 + std::abs(ascii41.entities[i].box[k])));
+        binary41.entities[i].box[k] = ascii41.entities[i].box[k];
+      }
+    EXPECT_TRUE(binary41 == ascii41);
     EXPECT_TRUE(by_encoding["2.2_1"] == by_encoding["2.2_0"]);
     for (const auto& [encoding, m] : by_encoding) {
       SCOPED_TRACE(encoding);
       EXPECT_EQ(nodes_by_tag(m), nodes_by_tag(original));
-      EXPECT_EQ(elements_by_tag(m), elements_by_tag(original));
+      if (encoding.rfind("4.1", 0) == 0) {
+        EXPECT_EQ(elements_by_tag(m), elements_by_tag(original));
+      } else {  // Gmsh's MSH 2.2 writer numbers elements afresh: compare types and nodes
+        EXPECT_EQ(element_multiset(m), element_multiset(original));
+      }
     }
   }
 }
