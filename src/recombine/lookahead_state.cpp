@@ -148,15 +148,26 @@ LookaheadState::LookaheadState(const LookaheadGraph& g)
       quads_at_(g.num_nodes, 0),
       parent_(g.initial_parent),
       size_(g.num_nodes, 1),
+      tentative_(g.num_nodes, 0),
       stamp_(g.num_triangles, 0),
       owner_(g.num_triangles, 0) {
   for (NodeIndex v = 0; v < g.num_nodes; ++v)
     if (parent_[v] != v) ++size_[parent_[v]];
 }
 
-NodeIndex LookaheadState::find(NodeIndex v) const noexcept {
-  while (parent_[v] != v) v = parent_[v];
-  return v;
+NodeIndex LookaheadState::find(NodeIndex v) noexcept {
+  // Settled links first, up to a root of the settled forest (a root, or a node linked
+  // tentatively), compressing them; then the few tentative links (at most 3 per merge
+  // applied since the last settle).
+  NodeIndex r = v;
+  while (parent_[r] != r && !tentative_[r]) r = parent_[r];
+  while (v != r) {
+    const NodeIndex next = parent_[v];
+    parent_[v] = r;
+    v = next;
+  }
+  while (parent_[r] != r) r = parent_[r];
+  return r;
 }
 
 void LookaheadState::unite(NodeIndex a, NodeIndex b) {
@@ -165,6 +176,7 @@ void LookaheadState::unite(NodeIndex a, NodeIndex b) {
   if (size_[ra] < size_[rb]) std::swap(ra, rb);
   parent_[rb] = ra;
   size_[ra] += size_[rb];
+  tentative_[rb] = 1;
   union_log_.push_back(rb);
   ++unions_per_apply_.back();
 }
@@ -190,7 +202,7 @@ void LookaheadState::apply(std::uint32_t p) {
 }
 
 void LookaheadState::undo() {
-  QV_ASSERT(!applied_.empty(), "nothing to undo");
+  QV_ASSERT(applied_.size() > settled_, "nothing to undo");
   const std::uint32_t p = applied_.back();
   applied_.pop_back();
   for (int i = unions_per_apply_.back(); i > 0; --i) {
@@ -198,12 +210,20 @@ void LookaheadState::undo() {
     union_log_.pop_back();
     size_[parent_[child]] -= size_[child];
     parent_[child] = child;
+    tentative_[child] = 0;
   }
   unions_per_apply_.pop_back();
   for (NodeIndex v : lookahead_quad(*g_, p)) --quads_at_[v];
   const TrianglePair& q = g_->pairs[p];
   free_[q.t0] = free_[q.t1] = 1;
   quality_ -= g_->reward[p];
+}
+
+void LookaheadState::settle() {
+  for (NodeIndex child : union_log_) tentative_[child] = 0;
+  union_log_.clear();
+  unions_per_apply_.clear();
+  settled_ = applied_.size();
 }
 
 int LookaheadState::allowed_options(std::uint32_t t, std::array<std::uint32_t, 3>* out) {

@@ -99,6 +99,10 @@ class LookaheadState {
   /// Merges pair p (must be available). Undo with undo(), last in first out.
   void apply(std::uint32_t p);
   void undo();
+  /// Makes every merge applied so far permanent (no longer undoable), so that the
+  /// union-find may compress their paths: called on the committed state of a run, it keeps
+  /// the finds short (the complement component grows to the size of the mesh).
+  void settle();
 
   double quality() const noexcept { return quality_; }
   std::size_t quads() const noexcept { return applied_.size(); }
@@ -107,7 +111,7 @@ class LookaheadState {
   std::uint64_t search_steps() const noexcept { return search_steps_; }
 
  private:
-  NodeIndex find(NodeIndex v) const noexcept;
+  NodeIndex find(NodeIndex v) noexcept;
   void unite(NodeIndex a, NodeIndex b);
   bool closed_corner(NodeIndex v) const noexcept {
     return g_->boundary_node[v] || quads_at_[v] > 0;
@@ -120,10 +124,14 @@ class LookaheadState {
   const LookaheadGraph* g_;
   std::vector<char> free_;
   std::vector<std::uint16_t> quads_at_;
-  std::vector<NodeIndex> parent_;          // union-find by size, no path compression (undo)
+  // Union-find by size. Links made by settled merges are compressed on find; links made
+  // since (tentative_[child] set) are not, so that undo can cut them.
+  std::vector<NodeIndex> parent_;
   std::vector<std::uint32_t> size_;
-  std::vector<NodeIndex> union_log_;       // children attached, per apply in unions_per_apply_
+  std::vector<char> tentative_;
+  std::vector<NodeIndex> union_log_;       // tentative children, per apply in unions_per_apply_
   std::vector<std::uint8_t> unions_per_apply_;
+  std::size_t settled_ = 0;                // applied_[0, settled_) cannot be undone
   std::vector<std::uint32_t> applied_;
   double quality_ = 0.0;
   // Search scratch: stamp_[t] == epoch_ marks t as seen, owner_[t] the search that saw it.

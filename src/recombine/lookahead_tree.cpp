@@ -15,13 +15,24 @@ namespace {
 
 using Rng = std::mt19937_64;
 
+// The tie-break order of the uniform tree: a random permutation of the pairs, drawn first
+// from the run's stream (the same draw for both implementations below).
+std::vector<std::uint32_t> tie_break_order(std::size_t num_pairs, Rng& rng) {
+  std::vector<std::uint32_t> order(num_pairs);
+  std::iota(order.begin(), order.end(), 0u);
+  std::shuffle(order.begin(), order.end(), rng);
+  return order;
+}
+
 // Uniform tree, horizon 1: the best allowed pair first. A pair found forbidden is dropped for
-// good (forbidden is forever), so this is the uniform tree of horizon 1 exactly.
+// good (forbidden is forever), so this is the uniform tree of horizon 1 exactly, ties
+// included: among equal rewards the pair earlier in the tie-break order wins, as in
+// UniformTree.
 void uniform_greedy(LookaheadState& s, Rng& rng) {
   const LookaheadGraph& g = s.graph();
-  std::vector<std::uint32_t> rank(g.pairs.size());
-  std::iota(rank.begin(), rank.end(), 0u);
-  std::shuffle(rank.begin(), rank.end(), rng);  // rank[p]: tie-break position of p
+  const std::vector<std::uint32_t> order = tie_break_order(g.pairs.size(), rng);
+  std::vector<std::uint32_t> rank(g.pairs.size());  // rank[p]: position of p in the order
+  for (std::uint32_t i = 0; i < order.size(); ++i) rank[order[i]] = i;
   auto worse = [&](std::uint32_t a, std::uint32_t b) {
     if (g.reward[a] != g.reward[b]) return g.reward[a] < g.reward[b];
     return rank[a] > rank[b];
@@ -33,18 +44,18 @@ void uniform_greedy(LookaheadState& s, Rng& rng) {
   while (!heap.empty()) {
     const std::uint32_t p = heap.top();
     heap.pop();
-    if (s.allowed(p)) s.apply(p);
+    if (s.allowed(p)) {
+      s.apply(p);
+      s.settle();
+    }
   }
 }
 
 // Uniform tree, any horizon: every allowed pair at every node.
 class UniformTree {
  public:
-  UniformTree(LookaheadState& s, int horizon, Rng& rng) : s_(s), horizon_(horizon) {
-    order_.resize(s.graph().pairs.size());
-    std::iota(order_.begin(), order_.end(), 0u);
-    std::shuffle(order_.begin(), order_.end(), rng);
-  }
+  UniformTree(LookaheadState& s, int horizon, Rng& rng)
+      : s_(s), horizon_(horizon), order_(tie_break_order(s.graph().pairs.size(), rng)) {}
   void run() {
     while (true) {
       std::uint32_t best_p = kNone;
@@ -56,6 +67,7 @@ class UniformTree {
       }
       if (best_p == kNone) return;
       s_.apply(best_p);
+      s_.settle();
     }
   }
 
@@ -199,6 +211,7 @@ class SelectiveTree {
 
   void commit(std::uint32_t p) {
     s_.apply(p);
+    s_.settle();
     place(g_.pairs[p].t0, 0);
     place(g_.pairs[p].t1, 0);
     // Counts change through the corners of the new quad: re-count the free triangles at its
@@ -233,6 +246,24 @@ class SelectiveTree {
 
 }  // namespace
 
+namespace {
+
+LookaheadOutcome outcome_of(const LookaheadGraph& g, const LookaheadState& s, std::uint64_t seed,
+                            std::chrono::steady_clock::time_point start) {
+  LookaheadOutcome out;
+  out.pairs = s.applied();
+  out.run.seed = seed;
+  // Summed afresh: the state's running sum carries the rounding of every apply/undo.
+  for (std::uint32_t p : out.pairs) out.run.quality += g.reward[p];
+  out.run.quads = s.quads();
+  out.run.triangles_left = g.num_triangles - 2 * s.quads();
+  out.run.search_steps = s.search_steps();
+  out.run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace
+
 LookaheadOutcome lookahead_run(const LookaheadGraph& g, const LookaheadOptions& options,
                                std::uint64_t seed) {
   QV_ASSERT(options.horizon >= 1, "horizon " << options.horizon);
@@ -246,16 +277,17 @@ LookaheadOutcome lookahead_run(const LookaheadGraph& g, const LookaheadOptions& 
   } else {
     SelectiveTree(s, options.horizon, rng).run();
   }
-  LookaheadOutcome out;
-  out.pairs = s.applied();
-  out.run.seed = seed;
-  // Summed afresh: the state's running sum carries the rounding of every apply/undo.
-  for (std::uint32_t p : out.pairs) out.run.quality += g.reward[p];
-  out.run.quads = s.quads();
-  out.run.triangles_left = g.num_triangles - 2 * s.quads();
-  out.run.search_steps = s.search_steps();
-  out.run.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return out;
+  return outcome_of(g, s, seed, start);
+}
+
+LookaheadOutcome uniform_enumeration_run(const LookaheadGraph& g, int horizon,
+                                         std::uint64_t seed) {
+  QV_ASSERT(horizon >= 1, "horizon " << horizon);
+  const auto start = std::chrono::steady_clock::now();
+  Rng rng(seed);
+  LookaheadState s(g);
+  UniformTree(s, horizon, rng).run();
+  return outcome_of(g, s, seed, start);
 }
 
 LookaheadBest lookahead_best_of(const LookaheadGraph& g, const LookaheadOptions& options) {

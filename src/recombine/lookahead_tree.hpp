@@ -30,6 +30,12 @@ struct LookaheadOutcome {
 LookaheadOutcome lookahead_run(const LookaheadGraph& g, const LookaheadOptions& options,
                                std::uint64_t seed);
 
+/// The uniform tree (§4) by plain enumeration, at any horizon, with the same random stream
+/// as lookahead_run: lookahead_run uses it for horizons >= 2 and a priority queue for
+/// horizon 1; at horizon 1 both must give the same sequence for the same seed (ties
+/// included), which the tests check through this entry point.
+LookaheadOutcome uniform_enumeration_run(const LookaheadGraph& g, int horizon, std::uint64_t seed);
+
 struct LookaheadBest {
   LookaheadOutcome best;
   std::size_t best_run = 0;

@@ -1,2 +1,3 @@
 list(APPEND QUADVAL_TEST_SOURCES
+  cli/info_cli_test.cpp
 )

@@ -124,6 +124,64 @@ TEST(LookaheadTree, UniformHorizonOneIsGreedyWithTheCriterion) {
   EXPECT_GE(compared, 15);
 }
 
+// lookahead_run answers uniform horizon 1 with a priority queue (exact by "forbidden is
+// forever"); the enumeration used for horizons >= 2 must give the very same sequence at
+// horizon 1, ties included: on an unjittered grid many rewards are exactly equal.
+TEST(LookaheadTree, UniformHorizonOneShortcutEqualsTheEnumeration) {
+  int compared = 0, with_ties = 0;
+  for (unsigned seed = 1; seed <= 16; ++seed) {
+    const double jitter = seed % 2 == 0 ? 0.0 : 0.3;
+    const Mesh m = test::random_grid_mesh(5 + seed % 3, 4, 300 + seed, 2 * (seed % 3), true, jitter);
+    const auto f = test::make_lookahead_fixture(m);
+    if (!even_components(f, std::vector<char>(f.graph.num_triangles, 1))) continue;
+    LookaheadOptions o;
+    o.tree = LookaheadTree::uniform;
+    o.horizon = 1;
+    const auto queue = lookahead_run(f.graph, o, seed);
+    const auto enumerated = recombine_detail::uniform_enumeration_run(f.graph, 1, seed);
+    EXPECT_EQ(queue.pairs, enumerated.pairs) << "seed " << seed;
+    EXPECT_EQ(queue.run.quality, enumerated.run.quality) << "seed " << seed;
+    expect_valid_sequence(f, queue.pairs);
+    with_ties += distinct_rewards(f.graph) ? 0 : 1;
+    ++compared;
+  }
+  EXPECT_GE(compared, 10);
+  EXPECT_GE(with_ties, 4);
+}
+
+// The horizon-2 enumeration against the rule of §4 written here with the brute-force
+// criterion: apply the first pair of a best two-step sequence (one step when nothing follows).
+// Its tie-break is not reproduced here, so compare the values chosen at each step: the
+// enumeration's choice must reach the best two-step value of the state it is in.
+TEST(LookaheadTree, UniformHorizonTwoTakesABestTwoStepSequence) {
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const Mesh m = test::random_grid_mesh(4, 3, 500 + seed, 0, true, 0.3);
+    const auto f = test::make_lookahead_fixture(m);
+    const LookaheadGraph& g = f.graph;
+    const auto run = recombine_detail::uniform_enumeration_run(g, 2, seed);
+    std::vector<char> free(g.num_triangles, 1);
+    auto value = [&](std::uint32_t p) {
+      std::vector<char> after = free;
+      after[g.pairs[p].t0] = after[g.pairs[p].t1] = 0;
+      double next = 0;
+      for (std::uint32_t q = 0; q < g.pairs.size(); ++q)
+        if (test::oracle_allowed(f, after, g.pairs[q].t0, g.pairs[q].t1))
+          next = std::max(next, g.reward[q]);
+      return g.reward[p] + next;
+    };
+    for (std::uint32_t p : run.pairs) {
+      double best = -1;
+      for (std::uint32_t q = 0; q < g.pairs.size(); ++q)
+        if (test::oracle_allowed(f, free, g.pairs[q].t0, g.pairs[q].t1))
+          best = std::max(best, value(q));
+      ASSERT_TRUE(test::oracle_allowed(f, free, g.pairs[p].t0, g.pairs[p].t1));
+      EXPECT_NEAR(value(p), best, 1e-12) << "seed " << seed;
+      free[g.pairs[p].t0] = free[g.pairs[p].t1] = 0;
+    }
+    expect_valid_sequence(f, run.pairs);
+  }
+}
+
 TEST(LookaheadTree, FullHorizonFindsTheBruteForceOptimum) {
   int compared = 0, perfect = 0;
   for (unsigned seed = 1; seed <= 14; ++seed) {

@@ -7,4 +7,6 @@ list(APPEND QUADVAL_TEST_SOURCES
   recombine/recombine_cli_test.cpp
   recombine/lookahead_criterion_test.cpp
   recombine/lookahead_tree_test.cpp
+  recombine/lookahead_parity_test.cpp
+  recombine/lookahead_cli_test.cpp
 )
