@@ -11,6 +11,7 @@
 #include <sstream>
 #include <sys/wait.h>
 
+#include "cli_run.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/io.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -20,20 +21,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code;
-  std::string output;
-};
-
-CliRun run_cli(const std::string& args) {
-  const std::string cmd = std::string(QUADVAL_CLI_PATH) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 4096> buf;
-  while (std::size_t n = fread(buf.data(), 1, buf.size(), p)) out.append(buf.data(), n);
-  const int status = pclose(p);
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
-}
+using testing_cli::CliRun;
+using testing_cli::run_cli;
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);

@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_run.hpp"
 #include "io/io_test_support.hpp"
 
 namespace quadval {
@@ -13,23 +14,12 @@ namespace {
 using ::testing::HasSubstr;
 using testing_io::ScratchDir;
 
-struct CliRun {
-  int code;
-  std::string out, err;
-};
-
-CliRun run_info(const ScratchDir& dir, const std::string& args) {
-  const std::string cmd = std::string(QUADVAL_CLI_PATH) + " info " + args + " >" +
-                          (dir / "stdout").string() + " 2>" + (dir / "stderr").string();
-  const int status = std::system(cmd.c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, testing_io::file_bytes(dir / "stdout"),
-          testing_io::file_bytes(dir / "stderr")};
-}
+using testing_cli::CliRun;
 
 TEST(InfoCli, RectangleTrianglesFromGmsh) {
   ScratchDir dir("info_rect");
   const std::string in = std::string(QUADVAL_SHARED_DIR) + "/data/tri/uniform-10k-a6.msh";
-  const CliRun r = run_info(dir, in + " --json");
+  const CliRun r = testing_cli::run_cli("info " + in + " --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto d = nlohmann::json::parse(r.out);
   const auto& t = d["triangles"];
@@ -53,16 +43,15 @@ TEST(InfoCli, OddAndNonManifoldSurfaceIsReportedNotRejected) {
   testing_io::write_bytes(dir / "fin.off",
                           "OFF\n5 3 0\n0 0 0\n1 0 0\n0.5 1 0\n0.5 -1 0\n0.5 0 1\n"
                           "3 0 1 2\n3 1 0 3\n3 0 1 4\n");
-  const CliRun r = run_info(dir, (dir / "fin.off").string());
+  const CliRun r = testing_cli::run_cli("info " + (dir / "fin.off").string());
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_THAT(r.out, HasSubstr("triangles 3 (odd)"));
   EXPECT_THAT(r.out, HasSubstr("non-manifold edges 1 (node tags: 1-2)"));
 }
 
 TEST(InfoCli, CurvedMeshCountsByType) {
-  ScratchDir dir("info_curved");
-  const CliRun r = run_info(
-      dir, std::string(QUADVAL_SHARED_DIR) + "/data/curved/tets_h0.8_o2.msh --json");
+  const CliRun r = testing_cli::run_cli(
+      "info " + std::string(QUADVAL_SHARED_DIR) + "/data/curved/tets_h0.8_o2.msh --json");
   ASSERT_EQ(r.code, 0) << r.err;
   const auto d = nlohmann::json::parse(r.out);
   bool found = false;
@@ -78,10 +67,10 @@ TEST(InfoCli, CurvedMeshCountsByType) {
 
 TEST(InfoCli, MissingFileAndDirectoryExitTwo) {
   ScratchDir dir("info_bad");
-  CliRun r = run_info(dir, (dir / "nope.msh").string());
+  CliRun r = testing_cli::run_cli("info " + (dir / "nope.msh").string());
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("nope.msh"));
-  r = run_info(dir, dir.path().string());
+  r = testing_cli::run_cli("info " + dir.path().string());
   EXPECT_EQ(r.code, 2);
   EXPECT_THAT(r.err, HasSubstr("directory"));
 }

@@ -19,6 +19,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "cli_run.hpp"
 #include "quadval/io.hpp"
 
 namespace quadval {
@@ -27,22 +28,8 @@ namespace {
 using testing::HasSubstr;
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int rc = -1;
-  std::string output;  // stdout and stderr
-};
-
-CliRun run_cli(const std::string& args) {
-  CliRun r;
-  const std::string command = fmt::format("'{}' {} 2>&1", QUADVAL_CLI_PATH, args);
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return r;
-  char buffer[4096];
-  while (std::fgets(buffer, sizeof buffer, pipe)) r.output += buffer;
-  const int status = pclose(pipe);
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using testing_cli::CliRun;
+using testing_cli::run_cli;
 
 fs::path scratch(const std::string& name) {
   const auto dir = fs::temp_directory_path() / "quadval_mesh_cli_test" / name;
@@ -161,7 +148,7 @@ TEST_P(DemoRuns, TrianglesEvenQuadsOnlyOnTheGeometryAndQualityInBounds) {
   const DemoCase& d = GetParam();
   const fs::path dir = scratch(d.name);
   const CliRun r = run_cli(fmt::format("demo {} -o '{}'", d.name, dir.string()));
-  ASSERT_EQ(r.rc, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.output;
   const fs::path out = dir / d.name;
   EXPECT_THAT(r.output, HasSubstr("efficiency index tau"));
   EXPECT_THAT(r.output, HasSubstr((out / "quads-eta.svg").string()));
@@ -220,12 +207,12 @@ INSTANTIATE_TEST_SUITE_P(Builtin, DemoRuns, testing::ValuesIn(kDemoCases),
 
 TEST(DemoCli, ListsTheDemosAndRejectsAnUnknownOne) {
   const CliRun list = run_cli("demo --list");
-  EXPECT_EQ(list.rc, 0);
+  EXPECT_EQ(list.code, 0);
   EXPECT_THAT(list.output, HasSubstr("rectangle"));
   EXPECT_THAT(list.output, HasSubstr("square-hole"));
   EXPECT_THAT(list.output, HasSubstr("uniform-square"));
   const CliRun bad = run_cli("demo nosuch -o " + scratch("nosuch").string());
-  EXPECT_EQ(bad.rc, 2);
+  EXPECT_EQ(bad.code, 2);
   EXPECT_THAT(bad.output, HasSubstr("no demo called 'nosuch'"));
 }
 
@@ -246,7 +233,7 @@ TEST(MeshCli, StepCylinderBecomesAnAllQuadSurfaceMesh) {
 
   const CliRun r = run_cli(fmt::format("mesh '{}' -o '{}' --size 0.12 --report '{}'", step.string(),
                                     (dir / "q.msh").string(), (dir / "r.json").string()));
-  ASSERT_EQ(r.rc, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.output;
   const auto report = read_json(dir / "r.json");
   EXPECT_TRUE(report["triangle_stage"]["all_curves_odd"].get<bool>());
   const Mesh q = read_mesh(dir / "q.msh");
@@ -276,7 +263,7 @@ TEST(MeshCli, PlanarDomainFromTheCommandLine) {
       "mesh --domain 'outer circle 0 0 1; hole rectangle -0.3 -0.2 0.3 0.2' --size 0.08 -o '{}' "
       "--recombine lookahead",
       (dir / "q.msh").string()));
-  ASSERT_EQ(r.rc, 0) << r.output;
+  ASSERT_EQ(r.code, 0) << r.output;
   // The look-ahead tree is quad-dominant (Paper II): a few triangles may stay.
   const Mesh q = read_mesh(dir / "q.msh");
   std::size_t quads = 0, triangles = 0;
@@ -327,7 +314,7 @@ TEST(MeshCli, BadGeometryAndSizeExitTwoWithAClearMessage) {
   for (const auto& c : cases) {
     const std::string args = fmt::format(fmt::runtime(c.args), fmt::arg("d", d), fmt::arg("tets", tets));
     const CliRun r = run_cli(args);
-    EXPECT_EQ(r.rc, 2) << args << "\n" << r.output;
+    EXPECT_EQ(r.code, 2) << args << "\n" << r.output;
     EXPECT_THAT(r.output, HasSubstr(c.message)) << args;
     EXPECT_THAT(r.output, testing::Not(HasSubstr("internal error"))) << args;
   }

@@ -10,6 +10,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "cli_run.hpp"
 #include "quadval/io.hpp"
 
 namespace quadval {
@@ -17,20 +18,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int code;
-  std::string output;  // stdout and stderr
-};
-
-CliRun run_cli(const std::string& args) {
-  const fs::path log = fs::temp_directory_path() / ("qv_cli_" + std::to_string(::getpid()) + ".log");
-  const std::string cmd = std::string(QUADVAL_CLI_PATH) + " " + args + " > " + log.string() + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  std::ifstream in(log);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  fs::remove(log);
-  return {WIFEXITED(rc) ? WEXITSTATUS(rc) : -1, text};
-}
+using testing_cli::CliRun;
+using testing_cli::run_cli;
 
 class RecombineCli : public ::testing::Test {
  protected:
