@@ -11,6 +11,7 @@
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/linear_jacobian.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
@@ -19,6 +20,7 @@ namespace quadval {
 namespace {
 
 constexpr std::size_t kChunk = 256;
+static_assert(kChunk <= kLinearChunk);
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -75,6 +77,9 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   bo.abs_tol = options.abs_tol;
   bo.max_subdivisions = options.max_subdivisions;
 
+  // First-order fast path (linear_jacobian.hpp): validity only; measuring refines further.
+  const bool fast_path = options.measure == CheckMeasure::validity;
+
   // Work list: (block, first element) chunks of the analysed dimension.
   struct Chunk {
     std::size_t block, first, count, out;
@@ -95,16 +100,21 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   std::vector<ThreadStats> stats(static_cast<std::size_t>(threads));
   std::atomic<std::size_t> done{0};
   std::exception_ptr failure;
-  // Build the shared spaces up front (once per type, outside the parallel region).
+  // Build the shared spaces up front (once per type, outside the parallel region), except
+  // for fast-path types: their space is built (thread-safely) only if an element needs it.
   for (const ElementBlock& blk : mesh.blocks)
-    if (blk.type->dim == report.dimension && jacobian_supported(*blk.type)) (void)jacobian_space(*blk.type);
+    if (blk.type->dim == report.dimension && jacobian_supported(*blk.type) &&
+        !(fast_path && linear_kind(*blk.type, report.planar) != LinearKind::none))
+      (void)jacobian_space(*blk.type);
 
 #pragma omp parallel num_threads(threads)
   {
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(omp_get_thread_num())];
-    std::vector<double> nodes, samples, errors, transposed, coeffs_t, coeffs, scratch;
+    std::vector<double> nodes, samples, errors, transposed, coeffs_t, coeffs, scratch, soa;
+    std::vector<JacobianBounds> fast_bounds;
+    bool decided[kLinearChunk];
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t c = 0; c < chunks.size(); ++c) {
       try {
@@ -116,47 +126,91 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
           ec.tag = blk.tags[ch.first + i];
           ec.type = &type;
         }
+        const LinearKind fast = fast_path ? linear_kind(type, report.planar) : LinearKind::none;
         if (jacobian_supported(type)) {
-          const JacobianSpace& space = jacobian_space(type);
           const auto nn = static_cast<std::size_t>(type.num_nodes);
-          const auto s = static_cast<std::size_t>(space.num_samples());
-          nodes.resize(ch.count * nn * 3);
-          for (std::size_t i = 0; i < ch.count; ++i) {
-            const auto conn = blk.element(ch.first + i);
-            for (std::size_t k = 0; k < nn; ++k)
-              for (std::size_t j = 0; j < 3; ++j)
-                nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
-          }
-          samples.resize(ch.count * s);
-          errors.resize(ch.count);
-          const double ts = now_seconds();
-          jacobian_samples(space, SampleMap::curved, nodes.data(), ch.count, report.planar,
-                           samples.data(), errors.data(), ws.sample_scratch);
-          // First Bézier coefficients of the whole chunk: one matrix-matrix product.
-          transposed.resize(ch.count * s);
-          for (std::size_t i = 0; i < ch.count; ++i)
-            for (std::size_t k = 0; k < s; ++k) transposed[k * ch.count + i] = samples[i * s + k];
-          coeffs_t.resize(ch.count * s);
-          scratch.resize(2 * ch.count * s);
-          space.basis().to_bezier_batch(transposed.data(), ch.count, coeffs_t.data(), scratch.data());
-          coeffs.resize(ch.count * s);
-          for (std::size_t i = 0; i < ch.count; ++i)
-            for (std::size_t k = 0; k < s; ++k) coeffs[i * s + k] = coeffs_t[k * ch.count + i];
-          const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
-          for (std::size_t i = 0; i < ch.count; ++i) {
-            const double te = now_seconds();
-            ElementCheck& ec = report.elements[ch.out + i];
-            const double* xe = nodes.data() + i * nn * 3;
+          // What every analysed element gets once its bounds are known.
+          const auto finish = [&](ElementCheck& ec, const double* xe, double seconds) {
             ec.analysed = true;
-            ec.bounds = bounds_from_samples(space, samples.data() + i * s, errors[i], xe,
-                                            report.planar, bo, ws, coeffs.data() + i * s);
             const JacobianBounds& b = ec.bounds;
             if (b.jmax_upper > 0) ec.ratio_lower = next_down(b.jmin_lower / b.jmax_upper);
             if (b.javg > 0) ec.jmin_over_javg = b.jmin_lower / b.javg;
             if (options.measure == CheckMeasure::distortion)
-              ec.distortion = distortion_from(space, xe, report.planar, b, ws);
+              ec.distortion = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
             if (b.exact) ++st.exact;
-            st.add(b.stage, b.validity, batch_share + (now_seconds() - te));
+            st.add(b.stage, b.validity, seconds);
+          };
+          if (fast != LinearKind::none) {
+            // First-order fast path (linear_jacobian.hpp): the coefficients straight from
+            // the vertices; the few it leaves open go one by one to the general path.
+            const double ts = now_seconds();
+            const auto nv = static_cast<std::size_t>(linear_num_vertices(fast));
+            soa.resize(nv * 3 * ch.count);
+            for (std::size_t i = 0; i < ch.count; ++i) {
+              const auto conn = blk.element(ch.first + i);
+              for (std::size_t k = 0; k < nv; ++k)
+                for (std::size_t j = 0; j < 3; ++j)
+                  soa[(k * 3 + j) * ch.count + i] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+            }
+            fast_bounds.resize(ch.count);
+            linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
+            const double share = (now_seconds() - ts) / static_cast<double>(ch.count);
+            nodes.resize(nn * 3);
+            errors.resize(1);
+            for (std::size_t i = 0; i < ch.count; ++i) {
+              ElementCheck& ec = report.elements[ch.out + i];
+              const auto conn = blk.element(ch.first + i);
+              if (decided[i]) {
+                ec.bounds = fast_bounds[i];
+                finish(ec, nullptr, share);
+                continue;
+              }
+              const double te = now_seconds();
+              const JacobianSpace& space = jacobian_space(type);
+              samples.resize(static_cast<std::size_t>(space.num_samples()));
+              for (std::size_t k = 0; k < nn; ++k)
+                for (std::size_t j = 0; j < 3; ++j)
+                  nodes[k * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+              jacobian_samples(space, SampleMap::curved, nodes.data(), 1, report.planar,
+                               samples.data(), errors.data(), ws.sample_scratch);
+              ec.bounds = bounds_from_samples(space, samples.data(), errors[0], nodes.data(),
+                                              report.planar, bo, ws);
+              finish(ec, nodes.data(), share + (now_seconds() - te));
+            }
+          } else {
+            const JacobianSpace& space = jacobian_space(type);
+            const auto s = static_cast<std::size_t>(space.num_samples());
+            nodes.resize(ch.count * nn * 3);
+            for (std::size_t i = 0; i < ch.count; ++i) {
+              const auto conn = blk.element(ch.first + i);
+              for (std::size_t k = 0; k < nn; ++k)
+                for (std::size_t j = 0; j < 3; ++j)
+                  nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+            }
+            samples.resize(ch.count * s);
+            errors.resize(ch.count);
+            const double ts = now_seconds();
+            jacobian_samples(space, SampleMap::curved, nodes.data(), ch.count, report.planar,
+                             samples.data(), errors.data(), ws.sample_scratch);
+            // First Bézier coefficients of the whole chunk: one matrix-matrix product.
+            transposed.resize(ch.count * s);
+            for (std::size_t i = 0; i < ch.count; ++i)
+              for (std::size_t k = 0; k < s; ++k) transposed[k * ch.count + i] = samples[i * s + k];
+            coeffs_t.resize(ch.count * s);
+            scratch.resize(2 * ch.count * s);
+            space.basis().to_bezier_batch(transposed.data(), ch.count, coeffs_t.data(), scratch.data());
+            coeffs.resize(ch.count * s);
+            for (std::size_t i = 0; i < ch.count; ++i)
+              for (std::size_t k = 0; k < s; ++k) coeffs[i * s + k] = coeffs_t[k * ch.count + i];
+            const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
+            for (std::size_t i = 0; i < ch.count; ++i) {
+              const double te = now_seconds();
+              ElementCheck& ec = report.elements[ch.out + i];
+              const double* xe = nodes.data() + i * nn * 3;
+              ec.bounds = bounds_from_samples(space, samples.data() + i * s, errors[i], xe,
+                                              report.planar, bo, ws, coeffs.data() + i * s);
+              finish(ec, xe, batch_share + (now_seconds() - te));
+            }
           }
         }
         const std::size_t d = done.fetch_add(ch.count) + ch.count;

@@ -4,6 +4,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/jacobian_samples.cpp
   src/analysis/jacobian_engine.cpp
   src/analysis/jacobian_bounds.cpp
+  src/analysis/linear_jacobian.cpp
   src/analysis/check_mesh.cpp
   src/analysis/check_report.cpp
 )

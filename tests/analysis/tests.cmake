@@ -4,4 +4,5 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/gmsh_agreement_test.cpp
   analysis/check_cli_test.cpp
   analysis/pyramid_jacobian_test.cpp
+  analysis/linear_fast_path_test.cpp
 )

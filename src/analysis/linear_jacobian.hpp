@@ -1,0 +1,78 @@
+#pragma once
+// Fast certified path for first-order elements (issue 3, speed): the Bézier coefficients
+// of J written directly from the vertices, with an a priori rounding-error bound, for
+// whole chunks of elements at once (structure of arrays, no allocation, vectorisable).
+// Internal to src/analysis. Elements whose sign the coefficients do not settle are left
+// to the general path (jacobian_bounds.cpp), which is unchanged.
+//
+// J is the same J as the general path (jacobian_bounds.hpp), in Gmsh reference
+// coordinates: the [-1, 1] directions of quadrangles and hexahedra contribute an exact
+// factor 1/2 each. Degrees (Paper III Table 1): linear triangle and tetrahedron J is
+// constant; bilinear quadrangle (1,1); trilinear hexahedron (2,2,2), 27 coefficients.
+//
+// Hexahedron, on [0,1]^3 with vertex X_abc (a, b, c in {0,1}; Gmsh node order 0..7 is
+// abc = 000 100 110 010 001 101 111 011): with the edge vectors
+//   eu_bc = X_1bc - X_0bc,  ev_ac = X_a1c - X_a0c,  ew_ab = X_ab1 - X_ab0,
+// X_u = sum_bc eu_bc B_b(v) B_c(w) (B_0 = 1-t, B_1 = t), likewise X_v, X_w, so
+//   J = sum det[eu_bc, ev_a'c', ew_a"b"] B_a'(u) B_a"(u) B_b(v) B_b"(v) B_c(w) B_c'(w),
+// and B_i B_j = B^2_{i+j} / binom(2, i+j) gives the degree-(2,2,2) coefficient
+//   c_ijk = mean over {a' + a" = i, b + b" = j, c + c' = k} of det[eu_bc, ev_a'c', ew_a"b"]
+// (1, 2, 4 or 8 determinants), times 1/8 for Gmsh's [-1,1]^3. Corner coefficients (i, j,
+// k in {0, 2}) are single determinants: the values of J at the vertices.
+// Quadrangle likewise: c_ab = (eu_b x ev_a) . z / 4, each a corner value.
+//
+// Rounding-error bound (u = 2^-53, no underflow or overflow; see below). A computed edge
+// is e (1 + d), |d| <= u. A 3x3 determinant a . (b x c) computed from computed edges
+// differs from the exact one by at most gamma_5 perm|A~| + gamma_3 perm|A| <= 8.01 u P,
+// P = ||a||_1 ||b||_1 ||c||_1 >= perm|A| (each of the 6 products suffers at most 5
+// roundings; the edges add 3 more relative errors). Summing m <= 8 such determinants and
+// scaling by 2^-k (exact) adds gamma_7 max|det~| <= 7.01 u (1 + 8.01 u) P. So every
+// coefficient is within 15.1 u P of the exact one, P = Lu Lv Lw with L the largest 1-norm
+// of an edge of that direction. The computed P~ (two roundings in each 1-norm, two in
+// the product) satisfies P <= (1 + 9u) P~; we use err = 32 u P~ times the reference
+// scaling, rounded up: a margin of 2 that also covers the gradual-underflow case below.
+// Tetrahedron (one determinant, 8.01 u P) and triangle (a 2x2 determinant, 4.01 u P) use
+// the same err = 32 u P~.
+// Underflow/overflow: the fast path is taken only when every L lies in [2^-200, 2^200];
+// then an underflowing product (absolute error <= 2^-1075) times a factor <= 2^200 costs
+// <= 2^-870 << u P (P >= 2^-600), and nothing overflows; otherwise (or for NaN) the element
+// goes to the general path.
+#include <cstddef>
+
+#include "quadval/jacobian_bounds.hpp"
+
+namespace quadval {
+
+/// The first-order types with a fast path (check_mesh, validity goal).
+enum class LinearKind : std::uint8_t { none, triangle, quadrangle, tetrahedron, hexahedron };
+
+/// The fast-path kind of `type`: triangles and quadrangles only when `planar` (J with n =
+/// +z; the general path's unit normal of a non-planar element is not handled here).
+LinearKind linear_kind(const ElementType& type, bool planar) noexcept;
+
+/// Number of vertices (2D: x, y only are read) of a kind.
+int linear_num_vertices(LinearKind kind) noexcept;
+
+/// Largest chunk linear_validity_chunk accepts.
+inline constexpr std::size_t kLinearChunk = 256;
+
+/// Bézier coefficients of J of one first-order element and their common error bound.
+/// @param nodes  #vertices x 3 coordinates, Gmsh node order
+/// @param coeffs out: 1 (triangle, tetrahedron), 4 (quadrangle: index a + 2 b) or 27
+///               (hexahedron: index i + 3 j + 9 k) coefficients
+/// @return err with |coeffs[n] - exact| <= err for every n, or +inf when outside the
+///         range where the bound holds (then the coefficients are not to be used)
+double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double* coeffs) noexcept;
+
+/// The fast validity check of a chunk of first-order elements.
+/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * count + e]
+/// @param count   elements, at most kLinearChunk
+/// @param out     count results; out[e] is written only where decided[e]
+/// @param decided out: true where the coefficients settled the sign: valid (stage 1, all
+///                coefficients > err) or invalid (stage 0, a vertex value proven <= 0).
+///                Bounds are as the general path's stage-1 bounds: jmin in [min c - err,
+///                min vertex c + err], jmax in [max vertex c - err, max c + err], outward.
+void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,
+                           JacobianBounds* out, bool* decided) noexcept;
+
+}  // namespace quadval
