@@ -16,7 +16,9 @@ rect-sin-a6.msh -> 932 quads, eta_min 0.422, eta_mean 0.754, 73.2% degree 4). Th
 times are its triangulation (not compared) and its recombination (the `time s` column).
 
 eta (Paper I eq. 3) and the degree statistics are computed here, in numpy, from each tool's
-output mesh, so both rows are measured the same way.
+output mesh, so both rows are measured the same way. `time s` is wall time, `CPU s` the
+process CPU time (user + system; quadval's includes its OpenMP threads), the fairer figure when
+other jobs share the machine.
 
     /usr/bin/python3 bench/compare_gmsh_recombine.py --quadval build/quadval
     /usr/bin/python3 bench/compare_gmsh_recombine.py --quadval build/quadval \
@@ -116,23 +118,24 @@ def summarize(xyz, quads, tris):
 def run_quadval(exe, path, runs):
     out = os.path.join(CACHE, "quadval_out.msh")
     report = os.path.join(CACHE, "quadval_report.json")
-    times, rss = [], 0
+    times, cpu, rss = [], [], 0
     for _ in range(runs):
         t0 = time.perf_counter()
-        r = subprocess.run(["/usr/bin/time", "-f", "%M", exe, "recombine", path, "-o", out,
+        r = subprocess.run(["/usr/bin/time", "-f", "%M %U %S", exe, "recombine", path, "-o", out,
                             "--report", report, "-q"], capture_output=True, text=True)
         times.append(time.perf_counter() - t0)
         if r.returncode != 0:
             sys.exit(f"quadval failed on {path}: {r.stderr}")
-        rss = max(rss, int(r.stderr.strip().splitlines()[-1]))
+        kb, user, system = r.stderr.strip().splitlines()[-1].split()
+        rss = max(rss, int(kb))
+        cpu.append(float(user) + float(system))
     with open(report) as f:
         rep = json.load(f)
     xyz, q, t = read_with_gmsh(out)
     row = summarize(xyz, q, t)
-    row.update(seconds=statistics.median(times), recombine_seconds=rep["statistics"]["total_seconds"],
-               rss_mb=rss / 1024)
+    row.update(seconds=statistics.median(times), cpu_seconds=statistics.median(cpu),
+               recombine_seconds=rep["statistics"]["total_seconds"], rss_mb=rss / 1024)
     return row
-
 
 
 def build_rect_sin():
@@ -234,15 +237,16 @@ def triangle_mesh(name, build):
 def run_gmsh(build, runs):
     """Gmsh's own pipeline, `runs` times on a fresh model: triangulate, then recombine the
     in-memory model (Blossom + smoothing + topology optimisation, Gmsh defaults)."""
-    tri_times, times = [], []
+    tri_times, times, cpu = [], [], []
     for _ in range(runs):
         tri_times.append(triangulate(build))
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         gmsh.model.mesh.recombine()
         times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
     row = summarize(*read_model())
-    row.update(seconds=statistics.median(times), triangulate_seconds=statistics.median(tri_times),
-               rss_mb=float("nan"))
+    row.update(seconds=statistics.median(times), cpu_seconds=statistics.median(cpu),
+               triangulate_seconds=statistics.median(tri_times), rss_mb=float("nan"))
     return row
 
 
@@ -260,7 +264,7 @@ def main():
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     print(f"{'mesh':18} {'tool':8} {'tris in':>9} {'quads':>8} {'tris':>5} {'eta_min':>7} "
-          f"{'eta_mean':>8} {'deg4%':>6} {'dmin':>4} {'dmax':>4} {'time s':>8} {'RSS MB':>7} "
+          f"{'eta_mean':>8} {'deg4%':>6} {'dmin':>4} {'dmax':>4} {'time s':>8} {'CPU s':>7} {'RSS MB':>7} "
           f"{'B/tri':>6}  notes")
     for name in args.cases:
         build = case_builder(name)
@@ -276,11 +280,13 @@ def main():
                     f"recombine() only; its triangulation {r['triangulate_seconds']:.3f} s")
             print(f"{name:18} {tool:8} {n:9d} {r['quads']:8d} {r['triangles']:5d} "
                   f"{r['eta_min']:7.3f} {r['eta_mean']:8.3f} {r['degree4']:6.1f} {r['dmin']:4d} "
-                  f"{r['dmax']:4d} {r['seconds']:8.3f} {r['rss_mb']:7.1f} {per_tri:6.0f}  {note}",
+                  f"{r['dmax']:4d} {r['seconds']:8.3f} {r['cpu_seconds']:7.3f} {r['rss_mb']:7.1f} {per_tri:6.0f}  {note}",
                   flush=True)
         if len(rows) == 2:
-            print(f"{'':18} time ratio gmsh recombine() / quadval end to end: "
-                  f"{rows[1][1]['seconds'] / rows[0][1]['seconds']:.1f}", flush=True)
+            g, q = rows[1][1], rows[0][1]
+            print(f"{'':18} ratio gmsh recombine() / quadval end to end: wall "
+                  f"{g['seconds'] / q['seconds']:.1f}, CPU {g['cpu_seconds'] / q['cpu_seconds']:.1f}",
+                  flush=True)
     gmsh.finalize()
 
 
