@@ -32,12 +32,13 @@ enum class PairCostKind {
   cross_field, ///< alignment of the removed edge with a cross field, Paper I eq. (7)
 };
 
-/// What to do when a region (the triangles of one surface entity) has an odd count.
+/// What to do when a connected piece of triangles (within one surface entity) has an odd
+/// count: then no perfect matching can exist.
 enum class OddPolicy {
-  /// Split the longest boundary edge of the region at its midpoint (its triangle becomes two):
-  /// the count becomes even, the boundary keeps its shape, the result is all-quad. A region
-  /// without a boundary edge (impossible for a closed manifold surface) falls back to
-  /// leave_triangle.
+  /// Split the longest boundary edge of each odd piece at its midpoint (its triangle becomes two):
+  /// the count becomes even, the boundary keeps its shape, the result is all-quad. A piece
+  /// without a boundary edge falls back to leave_triangle (a closed manifold surface never
+  /// needs it: 3T = 2E makes its triangle count even).
   split_boundary_edge,
   /// Match as many triangles as possible: at least one triangle is left in the output.
   leave_triangle,
@@ -88,7 +89,7 @@ struct StageTime {
 
 struct RecombineStats {
   std::size_t input_triangles = 0;
-  std::size_t odd_splits = 0;            ///< boundary edges split to make a region even
+  std::size_t odd_splits = 0;            ///< boundary edges split to make a piece even
   std::size_t graph_pairs = 0;           ///< real pairs (interior edges inside one region)
   std::size_t extra_pairs = 0;           ///< extra boundary edges added (§5.3)
   bool perfect_matching = false;         ///< every triangle matched (blossom) or paired

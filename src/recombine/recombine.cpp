@@ -165,20 +165,20 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
         options.source, fmt::format("the cross field has {} angles for {} triangles",
                                     options.cross_field_per_triangle.size(), s.triangles.size()));
   if (options.odd_policy == OddPolicy::split_boundary_edge) {
-    // The look-ahead criterion needs every connected piece even, not only every region.
-    if (options.algorithm == RecombineAlgorithm::blossom) make_regions_even(s);
-    if (options.algorithm == RecombineAlgorithm::lookahead) make_pieces_even(s);
+    // A perfect matching needs every connected piece of a region even (the dual graph of
+    // two pieces has no edge between them), and so does the look-ahead criterion.
+    if (options.algorithm != RecombineAlgorithm::greedy) make_pieces_even(s);
   }
   stats.odd_splits = s.odd_splits;
   if (s.odd_splits > 0)
     result.warnings.push_back(fmt::format(
-        "{} surface(s) had an odd number of triangles: no all-quad matching exists, so the "
-        "longest boundary edge of each was split at its midpoint",
+        "{} connected piece(s) had an odd number of triangles: no all-quad matching exists, "
+        "so the longest boundary edge of each was split at its midpoint",
         s.odd_splits));
   if (!s.odd_regions_left.empty())
     result.warnings.push_back(fmt::format(
-        "{} surface(s) have an odd number of triangles and no boundary edge to split: at "
-        "least one triangle will remain in each",
+        "{} connected piece(s) have an odd number of triangles and no boundary edge to split: "
+        "at least one triangle will remain in each",
         s.odd_regions_left.size()));
   timer.stage("input", fmt::format("{} triangles, {} regions", stats.input_triangles,
                                    s.region_entity.size()));

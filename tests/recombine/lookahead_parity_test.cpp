@@ -125,5 +125,16 @@ TEST(LookaheadParity, RecombineHandlesTwoOddPieces) {
   EXPECT_THROW(recombine(two_odd_pieces(), o), InputError);
 }
 
+TEST(LookaheadParity, BlossomIsAllQuadOnTwoOddPieces) {
+  // Two pieces of 17 triangles: each needs its own split for a perfect matching to exist.
+  RecombineOptions o;
+  o.algorithm = RecombineAlgorithm::blossom;
+  const RecombineResult r = recombine(two_odd_pieces(), o);
+  EXPECT_EQ(r.stats.odd_splits, 2u);
+  EXPECT_TRUE(r.stats.perfect_matching);
+  EXPECT_EQ(r.stats.triangles, 0u);
+  for (const auto& b : r.mesh.blocks) EXPECT_EQ(b.type->gmsh_id, 3);
+}
+
 }  // namespace
 }  // namespace quadval
