@@ -4,9 +4,11 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
@@ -31,6 +33,7 @@ double now_seconds() {
 struct ThreadStats {
   std::vector<StageRow> stages;
   std::size_t exact = 0;
+  std::map<int, std::array<std::size_t, 4>> counts;  // as CheckReport::counts
   void add(int stage, Validity v, double seconds) {
     const auto row = static_cast<std::size_t>(stage < 0 ? 0 : stage);
     if (stages.size() <= row) stages.resize(row + 1);
@@ -145,12 +148,12 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
             // the vertices; the few it leaves open go one by one to the general path.
             const double ts = now_seconds();
             const auto nv = static_cast<std::size_t>(linear_num_vertices(fast));
-            soa.resize(nv * 3 * ch.count);
+            soa.resize(nv * 3 * kLinearChunk);
             for (std::size_t i = 0; i < ch.count; ++i) {
               const auto conn = blk.element(ch.first + i);
               for (std::size_t k = 0; k < nv; ++k)
                 for (std::size_t j = 0; j < 3; ++j)
-                  soa[(k * 3 + j) * ch.count + i] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+                  soa[(k * 3 + j) * kLinearChunk + i] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
             }
             fast_bounds.resize(ch.count);
             linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
@@ -162,7 +165,7 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
               const auto conn = blk.element(ch.first + i);
               if (decided[i]) {
                 ec.bounds = fast_bounds[i];
-                finish(ec, nullptr, share);
+                finish(ec, nullptr, share);  // no distortion: fast_path is validity only
                 continue;
               }
               const double te = now_seconds();
@@ -213,6 +216,14 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
             }
           }
         }
+        // Counts per type, here rather than in a serial pass over all elements.
+        std::array<std::size_t, 4> chunk_counts{};
+        for (std::size_t i = 0; i < ch.count; ++i) {
+          const ElementCheck& ec = report.elements[ch.out + i];
+          chunk_counts[ec.analysed ? static_cast<std::size_t>(ec.bounds.validity) : 3] += 1;
+        }
+        auto& type_counts = st.counts[type.gmsh_id];
+        for (std::size_t k = 0; k < 4; ++k) type_counts[k] += chunk_counts[k];
         const std::size_t d = done.fetch_add(ch.count) + ch.count;
         if (options.progress && omp_get_thread_num() == 0) options.progress(d, total);
       } catch (...) {
@@ -225,6 +236,8 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
 
   for (const ThreadStats& st : stats) {
     report.exact_fallbacks += st.exact;
+    for (const auto& [id, c] : st.counts)
+      for (std::size_t k = 0; k < 4; ++k) report.counts[id][k] += c[k];
     if (report.stages.size() < st.stages.size()) report.stages.resize(st.stages.size());
     for (std::size_t i = 0; i < st.stages.size(); ++i) {
       report.stages[i].valid += st.stages[i].valid;
@@ -234,10 +247,6 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   }
   if (report.stages.size() < 2) report.stages.resize(2);
   for (std::size_t i = 0; i < report.stages.size(); ++i) report.stages[i].name = stage_name(i);
-  for (const ElementCheck& ec : report.elements) {
-    auto& c = report.counts[ec.type->gmsh_id];
-    c[ec.analysed ? static_cast<std::size_t>(ec.bounds.validity) : 3] += 1;
-  }
   report.seconds = now_seconds() - t0;
   return report;
 }

@@ -35,8 +35,10 @@
 // the same err = 32 u P~.
 // Underflow/overflow: the fast path is taken only when every L lies in [2^-200, 2^200];
 // then an underflowing product (absolute error <= 2^-1075) times a factor <= 2^200 costs
-// <= 2^-870 << u P (P >= 2^-600), and nothing overflows; otherwise (or for NaN) the element
-// goes to the general path.
+// <= 2^-870 << u P (P >= 2^-600), and nothing overflows; otherwise (or for a non-finite
+// coordinate) the element goes to the general path.
+// Outward rounding: err is rounded up, and every bound built from a coefficient and err
+// is rounded one ulp outward (next_up / next_down, outward_rounding.hpp).
 #include <cstddef>
 
 #include "quadval/jacobian_bounds.hpp"
@@ -65,7 +67,9 @@ inline constexpr std::size_t kLinearChunk = 256;
 double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double* coeffs) noexcept;
 
 /// The fast validity check of a chunk of first-order elements.
-/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * count + e]
+/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * kLinearChunk
+///                + e], #vertices * 3 * kLinearChunk doubles (entries e >= count are read,
+///                in groups of 8, and their results dropped: any values will do)
 /// @param count   elements, at most kLinearChunk
 /// @param out     count results; out[e] is written only where decided[e]
 /// @param decided out: true where the coefficients settled the sign: valid (stage 1, all
