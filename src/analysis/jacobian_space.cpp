@@ -15,6 +15,7 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "analysis/exact_inverse.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -236,39 +237,15 @@ void vandermonde_gradients(const ElementType& type, const BezierBasis& b,
     for (int k = 0; k < e; ++k) r *= x;
     return r;
   };
-  // V[i][j] = phi_j(node i); solve V C = I by Gauss-Jordan.
-  std::vector<mpq_class> v(n * n), inv(n * n, mpq_class(0));
-  for (std::size_t i = 0; i < n; ++i) {
-    inv[i * n + i] = 1;
+  // V[i][j] = phi_j(node i); C = V^{-1}.
+  std::vector<mpq_class> v(n * n);
+  for (std::size_t i = 0; i < n; ++i)
     for (std::size_t j = 0; j < n; ++j) {
       mpq_class x = 1;
       for (int c = 0; c < dim; ++c) x *= power(nodes[i][static_cast<std::size_t>(c)], space.exponents[j][static_cast<std::size_t>(c)]);
       v[i * n + j] = x;
     }
-  }
-  for (std::size_t col = 0; col < n; ++col) {
-    std::size_t piv = col;
-    while (piv < n && sgn(v[piv * n + col]) == 0) ++piv;
-    QV_ASSERT(piv < n, "nodes not unisolvent for " << type.name);
-    if (piv != col)
-      for (std::size_t c = 0; c < n; ++c) {
-        std::swap(v[piv * n + c], v[col * n + c]);
-        std::swap(inv[piv * n + c], inv[col * n + c]);
-      }
-    const mpq_class pv = v[col * n + col];
-    for (std::size_t c = 0; c < n; ++c) {
-      v[col * n + c] /= pv;
-      inv[col * n + c] /= pv;
-    }
-    for (std::size_t r = 0; r < n; ++r) {
-      if (r == col || sgn(v[r * n + col]) == 0) continue;
-      const mpq_class f = v[r * n + col];
-      for (std::size_t c = 0; c < n; ++c) {
-        v[r * n + c] -= f * v[col * n + c];
-        inv[r * n + c] -= f * inv[col * n + c];
-      }
-    }
-  }
+  const std::vector<mpq_class> inv = exact_inverse(std::move(v), n, type);
   // C = V^{-1}: N_i = sum_j phi_j C[j][i].
   const auto pts = exact_sample_points(b, shapes);
   const std::size_t s = pts.size();

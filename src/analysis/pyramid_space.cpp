@@ -6,6 +6,7 @@
 #include <limits>
 #include <mutex>
 
+#include "analysis/exact_inverse.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
@@ -35,36 +36,6 @@ mpq_class snap(double x, int p, const ElementType& type) {
 double nearest(const mpq_class& q) {
   const double d = q.get_d();
   return d + mpq_class(q - mpq_class(d)).get_d();
-}
-
-// C = V^{-1} (n x n, row-major) by exact Gauss-Jordan.
-std::vector<mpq_class> exact_inverse(std::vector<mpq_class> v, std::size_t n, const ElementType& type) {
-  std::vector<mpq_class> inv(n * n, mpq_class(0));
-  for (std::size_t i = 0; i < n; ++i) inv[i * n + i] = 1;
-  for (std::size_t col = 0; col < n; ++col) {
-    std::size_t piv = col;
-    while (piv < n && sgn(v[piv * n + col]) == 0) ++piv;
-    QV_ASSERT(piv < n, "pyramid nodes not unisolvent for " << type.name);
-    if (piv != col)
-      for (std::size_t c = 0; c < n; ++c) {
-        std::swap(v[piv * n + c], v[col * n + c]);
-        std::swap(inv[piv * n + c], inv[col * n + c]);
-      }
-    const mpq_class pv = v[col * n + col];
-    for (std::size_t c = 0; c < n; ++c) {
-      v[col * n + c] /= pv;
-      inv[col * n + c] /= pv;
-    }
-    for (std::size_t r = 0; r < n; ++r) {
-      if (r == col || sgn(v[r * n + col]) == 0) continue;
-      const mpq_class f = v[r * n + col];
-      for (std::size_t c = 0; c < n; ++c) {
-        if (sgn(v[col * n + c]) != 0) v[r * n + c] -= f * v[col * n + c];
-        if (sgn(inv[col * n + c]) != 0) inv[r * n + c] -= f * inv[col * n + c];
-      }
-    }
-  }
-  return inv;
 }
 
 // Distinct coordinates m / degree (m = 0..degree) of a line factor; {1} for a missing one.
