@@ -23,19 +23,7 @@
 namespace quadval {
 namespace {
 
-std::map<Tag, double> read_gmsh_ratios(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);  // header
-  std::map<Tag, double> out;
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::string cell[5];
-    for (auto& c : cell) std::getline(ss, c, ',');
-    out[std::stoull(cell[0])] = std::stod(cell[4]);
-  }
-  return out;
-}
+using test::read_gmsh_ratios;
 
 class GmshAgreementTest : public testing::TestWithParam<const char*> {};
 

@@ -3,6 +3,10 @@
 // straight from the Lagrange shape-function gradients (lagrange_basis.hpp), which shares
 // no code with the Bézier pipeline under test.
 #include <array>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -10,6 +14,7 @@
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/lagrange_basis.hpp"
+#include "quadval/mesh.hpp"
 
 namespace quadval::test {
 
@@ -128,6 +133,22 @@ inline std::vector<const ElementType*> analysed_types(int max_order_2d, int max_
         break;
       default: break;
     }
+  }
+  return out;
+}
+
+/// Gmsh's minJ/maxJ per element tag from a shared-data NAME.gmsh.csv (column 5; <= 0 means
+/// Gmsh calls the element invalid).
+inline std::map<Tag, double> read_gmsh_ratios(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);  // header
+  std::map<Tag, double> out;
+  while (std::getline(in, line)) {
+    std::stringstream ss(line);
+    std::string cell[5];
+    for (auto& c : cell) std::getline(ss, c, ',');
+    out[std::stoull(cell[0])] = std::stod(cell[4]);
   }
   return out;
 }

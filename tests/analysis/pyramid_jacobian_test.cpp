@@ -317,19 +317,7 @@ TEST(PyramidJacobian, ZeroAtACornerIsInvalidByExactArithmetic) {
   EXPECT_GE(b.jmin_upper, 0);
 }
 
-std::map<Tag, double> read_gmsh_ratios(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::map<Tag, double> out;
-  while (std::getline(in, line)) {
-    std::stringstream ss(line);
-    std::string cell[5];
-    for (auto& c : cell) std::getline(ss, c, ',');
-    out[std::stoull(cell[0])] = std::stod(cell[4]);
-  }
-  return out;
-}
+using test::read_gmsh_ratios;
 
 // Gmsh 4.8.4 on the warped pyramid meshes. Order 1: the same invalid set. Order 2: Gmsh
 // calls almost every pyramid invalid with J_min = 0; we prove them valid (jmin_lower > 0),

@@ -21,12 +21,7 @@ namespace {
 
 using F = ElementFamily;
 
-std::vector<const ElementType*> lagrange_types() {
-  std::vector<const ElementType*> out;
-  for (const ElementType& t : element_types())
-    if (t.has_lagrange_basis) out.push_back(&t);
-  return out;
-}
+using testing_data::lagrange_types;
 
 // Uniform-ish random points strictly inside the reference element (pyramid: zeta <= 0.9).
 std::vector<RefPoint> random_points(F f, int n, unsigned seed) {

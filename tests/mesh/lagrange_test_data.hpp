@@ -70,4 +70,12 @@ inline const GmshReference& gmsh_reference() {
   return data;
 }
 
+/// Every registry type that has a Lagrange basis.
+inline std::vector<const ElementType*> lagrange_types() {
+  std::vector<const ElementType*> out;
+  for (const ElementType& t : element_types())
+    if (t.has_lagrange_basis) out.push_back(&t);
+  return out;
+}
+
 }  // namespace quadval::testing_data

@@ -15,12 +15,7 @@ namespace {
 
 using F = ElementFamily;
 
-std::vector<const ElementType*> lagrange_types() {
-  std::vector<const ElementType*> out;
-  for (const ElementType& t : element_types())
-    if (t.has_lagrange_basis) out.push_back(&t);
-  return out;
-}
+using testing_data::lagrange_types;
 
 double distance(const RefPoint& a, const RefPoint& b) {
   return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
