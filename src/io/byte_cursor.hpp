@@ -7,14 +7,16 @@
 #include <string>
 #include <string_view>
 
+#include "io/file_bytes.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval::io {
 
 class ByteCursor {
  public:
-  ByteCursor(std::string_view data, std::string file, std::size_t pos)
-      : data_(data), file_(std::move(file)), pos_(pos) {}
+  /// `source`, when given, owns `data` and gets the parsed pages back (release_parsed).
+  ByteCursor(std::string_view data, std::string file, std::size_t pos, FileBytes* source = nullptr)
+      : data_(data), file_(std::move(file)), pos_(pos), source_(source) {}
 
   const std::string& file() const noexcept { return file_; }
   std::size_t position() const noexcept { return pos_; }
@@ -41,6 +43,13 @@ class ByteCursor {
   [[noreturn]] void fail_at(std::size_t pos, const std::string& message) const {
     throw InputError::at_offset(file_, static_cast<long long>(pos), message);
   }
+  /// Now and then gives the pages already parsed back to the OS (FileBytes).
+  void release_parsed() noexcept {
+    if (source_ != nullptr && pos_ >= next_release_) {
+      source_->release_before(pos_);
+      next_release_ = pos_ + kReleaseEvery;
+    }
+  }
   /// Offset of the value read last.
   std::size_t last_position() const noexcept { return last_; }
 
@@ -61,6 +70,8 @@ class ByteCursor {
   std::string file_;
   std::size_t pos_;
   std::size_t last_ = 0;
+  FileBytes* source_ = nullptr;
+  std::size_t next_release_ = kReleaseEvery;
 };
 
 }  // namespace quadval::io

@@ -37,7 +37,8 @@ Mesh read_mesh(const std::filesystem::path& path, std::vector<std::string>* warn
   const MeshFormat format = format_from_extension(path);
   if (format == MeshFormat::vtu)
     throw InputError::in_file(name, "reading VTU is not supported, expected .msh, .stl, .obj or .off");
-  const std::string bytes = io::read_file_bytes(path);
+  io::FileBytes file(path);
+  const std::string_view bytes = file.view();
   std::vector<std::string> local;
   std::vector<std::string>& out = warnings ? *warnings : local;
   Mesh mesh;
@@ -45,7 +46,7 @@ Mesh read_mesh(const std::filesystem::path& path, std::vector<std::string>* warn
     case MeshFormat::stl: mesh = io::read_stl(bytes, name, out); break;
     case MeshFormat::obj: mesh = io::read_obj(bytes, name, out); break;
     case MeshFormat::off: mesh = io::read_off(bytes, name, out); break;
-    default: mesh = io::read_msh(bytes, name, out); break;
+    default: mesh = io::read_msh(bytes, name, out, &file); break;
   }
   if (!warnings)
     for (const std::string& w : local) fmt::print(stderr, "quadval: warning: {}\n", w);

@@ -51,7 +51,7 @@ void skip_section(TextCursor& in, std::string_view name, bool binary) {
 /// The endianness marker of a binary file: an int 1 right after the $MeshFormat line.
 void check_endianness(TextCursor& in) {
   in.finish_line("the binary endianness marker");
-  ByteCursor bytes(in.data(), in.file(), in.position());
+  ByteCursor bytes(in.data(), in.file(), in.position(), in.source());
   const std::int32_t one = bytes.i32("the endianness marker (int 1)");
   if (one != 1) {
     const auto swapped = static_cast<std::int32_t>(
@@ -68,8 +68,9 @@ void check_endianness(TextCursor& in) {
 
 }  // namespace
 
-Mesh read_msh(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings) {
-  TextCursor in(bytes, file);
+Mesh read_msh(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings,
+              FileBytes* source) {
+  TextCursor in(bytes, file, source);
   if (in.at_end()) throw InputError::in_file(file, "empty file, expected a Gmsh MSH file starting with $MeshFormat");
   MshReadState state;
   state.file = file;

@@ -9,7 +9,7 @@ namespace {
 /// Runs `read` on the binary data that starts at in.position(), then moves `in` past it.
 template <class Read>
 void read_binary(TextCursor& in, Read&& read) {
-  ByteCursor bytes(in.data(), in.file(), in.position());
+  ByteCursor bytes(in.data(), in.file(), in.position(), in.source());
   BinarySource src{bytes};
   read(src);
   in.jump_to(bytes.position());
@@ -60,6 +60,7 @@ void read_elements22_binary(TextCursor& in, MshReadState& state) {
                   1, 4 * (1 + static_cast<std::uint64_t>(num_tags) + static_cast<std::uint64_t>(type.num_nodes)),
                   "elements");
       for (std::int32_t e = 0; e < group; ++e) {
+        src.release_parsed();
         const std::size_t where = src.where();
         const std::int32_t tag = src.int32("element tag");
         if (tag < 1) src.fail(fmt::format("element tag {}, expected a tag >= 1", tag));

@@ -63,7 +63,9 @@ void read_elements22_binary(TextCursor& in, MshReadState& state);
 /// `binary` chooses how positions22 are reported in errors.
 void finish_msh22(MshReadState& state, bool binary);
 
-/// Reads a whole MSH file (any supported version) held in `bytes`.
-Mesh read_msh(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings);
+/// Reads a whole MSH file (any supported version) held in `bytes`; `source`, when given,
+/// owns `bytes` and gets the pages already parsed back as reading goes (FileBytes).
+Mesh read_msh(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings,
+              FileBytes* source = nullptr);
 
 }  // namespace quadval::io

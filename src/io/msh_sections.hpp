@@ -37,6 +37,7 @@ struct AsciiSource {
   }
   void begin_record() { in.begin_record(); }
   void end_record(std::string_view what) { in.end_record(what); }
+  void release_parsed() noexcept { in.release_parsed(); }
   [[noreturn]] void fail(const std::string& message) { in.fail_at_token(message); }
   std::size_t where() const { return static_cast<std::size_t>(in.line()); }
 };
@@ -57,8 +58,9 @@ struct BinarySource {
                std::string_view what) {
     in.require(count, bytes_each, what);
   }
-  void begin_record() {}
+  void begin_record() { in.release_parsed(); }
   void end_record(std::string_view) {}
+  void release_parsed() noexcept { in.release_parsed(); }
   [[noreturn]] void fail(const std::string& message) { in.fail_at(in.last_position(), message); }
   std::size_t where() const { return in.position(); }
 };
@@ -170,12 +172,14 @@ void read_nodes41(Src& src, MshReadState& state) {
       if (!state.node_index.insert(tag, static_cast<std::uint32_t>(total + i)))
         src.fail(fmt::format("node tag {} appears twice", tag));
       mesh.node_tags.push_back(tag);
+      src.release_parsed();
     }
     for (std::uint64_t i = 0; i < count; ++i) {
       mesh.coords.push_back(src.real("node x coordinate"));
       mesh.coords.push_back(src.real("node y coordinate"));
       mesh.coords.push_back(src.real("node z coordinate"));
       for (int k = 0; k < num_param; ++k) src.real("parametric node coordinate");
+      src.release_parsed();
     }
     if (num_param > 0 && !state.warned_parametric) {
       state.warned_parametric = true;

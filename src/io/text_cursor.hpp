@@ -11,16 +11,20 @@
 #include <string>
 #include <string_view>
 
+#include "io/file_bytes.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval::io {
 
 class TextCursor {
  public:
-  TextCursor(std::string_view data, std::string file) : data_(data), file_(std::move(file)) {}
+  /// `source`, when given, owns `data` and gets the parsed pages back (release_parsed).
+  TextCursor(std::string_view data, std::string file, FileBytes* source = nullptr)
+      : data_(data), file_(std::move(file)), source_(source) {}
 
   const std::string& file() const noexcept { return file_; }
   std::string_view data() const noexcept { return data_; }
+  FileBytes* source() const noexcept { return source_; }
   std::size_t position() const noexcept { return pos_; }
   std::size_t remaining() const noexcept { return data_.size() - pos_; }
   long line() const noexcept { return line_; }
@@ -146,6 +150,14 @@ class TextCursor {
   void begin_record() noexcept {
     skip_space();
     record_line_ = line_;
+    release_parsed();
+  }
+  /// Now and then gives the pages already parsed back to the OS (FileBytes).
+  void release_parsed() noexcept {
+    if (source_ != nullptr && pos_ >= next_release_) {
+      source_->release_before(pos_);
+      next_release_ = pos_ + kReleaseEvery;
+    }
   }
   /// Checks that the record's tokens were all on its line and nothing else follows.
   void end_record(std::string_view what) {
@@ -196,6 +208,8 @@ class TextCursor {
   std::size_t token_pos_ = 0;
   long record_line_ = 1;
   bool offsets_only_ = false;
+  FileBytes* source_ = nullptr;
+  std::size_t next_release_ = kReleaseEvery;
 };
 
 }  // namespace quadval::io
