@@ -1,13 +1,17 @@
 // Throughput of the certified Jacobian check (check_mesh, validity) on structured meshes
 // built in memory: linear hexahedra with perturbed nodes, and third-order tetrahedra
-// (6 Kuhn tetrahedra per cube) with every lattice node perturbed, so all are curved.
+// (6 Kuhn tetrahedra per cube) with every lattice node perturbed, so all are curved
+// (amplitude 0.15 of the node spacing: more than half invalid; 0.05: mostly valid), the
+// same with second-order tetrahedra, and separate random curved hexahedra (orders 2, 3)
+// and pyramids (order 2).
 //
-//   build-jac/bench/quadval_bench --benchmark_filter=Check
+//   build-jac/bench/quadval_bench --benchmark_filter=Check --benchmark_repetitions=3
 // Counters: elements/s (wall), and the answers so a regression in them shows.
 #include <benchmark/benchmark.h>
 
 #include <array>
 #include <random>
+#include <utility>
 
 #include "quadval/check_report.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -59,6 +63,7 @@ Mesh curved_tets(int n, int p, double amp) {
   const auto ref = reference_nodes(type);
   // Kuhn subdivision of the unit cube: paths 0 -> 7 through the cube corners.
   static constexpr int kPerm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  static constexpr bool kOdd[6] = {false, true, true, false, false, true};
   ElementBlock b;
   b.type = &type;
   b.entity_dim = 3;
@@ -73,6 +78,8 @@ Mesh curved_tets(int n, int p, double amp) {
             v[static_cast<std::size_t>(s + 1)] = v[static_cast<std::size_t>(s)];
             v[static_cast<std::size_t>(s + 1)][static_cast<std::size_t>(perm[s])] = 1;
           }
+          // Odd permutations give negatively oriented tetrahedra: swap two vertices.
+          if (kOdd[&perm - kPerm]) std::swap(v[1], v[2]);
           b.tags.push_back(b.tags.size() + 1);
           for (const auto& r : ref) {
             const double lam[4] = {1 - r[0] - r[1] - r[2], r[0], r[1], r[2]};
@@ -85,6 +92,29 @@ Mesh curved_tets(int n, int p, double amp) {
             b.nodes.push_back(static_cast<NodeIndex>(q[0] + L * (q[1] + L * q[2])));
           }
         }
+  m.blocks.push_back(std::move(b));
+  return m;
+}
+
+// `count` elements of `type`, each with its own nodes: the reference nodes (element size
+// about 1) on a row, every node moved by up to `amp` at random, so all are curved.
+Mesh random_curved_block(const ElementType& type, std::size_t count, double amp) {
+  Mesh m;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-amp, amp);
+  const auto ref = reference_nodes(type);
+  ElementBlock b;
+  b.type = &type;
+  b.entity_dim = type.dim;
+  b.entity_tag = 1;
+  for (std::size_t e = 0; e < count; ++e) {
+    b.tags.push_back(b.tags.size() + 1);
+    for (const auto& r : ref) {
+      b.nodes.push_back(static_cast<NodeIndex>(m.node_tags.size()));
+      m.node_tags.push_back(m.node_tags.size() + 1);
+      m.coords.insert(m.coords.end(), {2.0 * static_cast<double>(e) + r[0] + u(rng), r[1] + u(rng), r[2] + u(rng)});
+    }
+  }
   m.blocks.push_back(std::move(b));
   return m;
 }
@@ -102,6 +132,10 @@ void run(benchmark::State& state, const Mesh& mesh) {
   state.counters["valid"] = static_cast<double>(r.count(Validity::valid));
   state.counters["invalid"] = static_cast<double>(r.count(Validity::invalid));
   state.counters["undetermined"] = static_cast<double>(r.count(Validity::undetermined));
+  // Elements that needed subdivision (stage >= 2 of Paper III Table 2).
+  std::size_t subdivided = 0;
+  for (std::size_t i = 2; i < r.stages.size(); ++i) subdivided += r.stages[i].valid + r.stages[i].invalid;
+  state.counters["subdivided"] = static_cast<double>(subdivided);
 }
 
 void BM_CheckLinearHex(benchmark::State& state) {
@@ -116,6 +150,32 @@ void BM_CheckCurvedTetP3(benchmark::State& state) {
 }
 // 6 * 55^3 = 998,250 tetrahedra
 BENCHMARK(BM_CheckCurvedTetP3)->Args({55, 1})->Args({55, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The same lattice with milder perturbations: mostly valid, as in a usable curved mesh.
+void BM_CheckCurvedTetP3Mild(benchmark::State& state) {
+  static const Mesh mesh = curved_tets(static_cast<int>(state.range(0)), 3, 0.05);
+  run(state, mesh);
+}
+BENCHMARK(BM_CheckCurvedTetP3Mild)->Args({55, 1})->Args({55, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CheckCurvedTetP2(benchmark::State& state) {
+  static const Mesh mesh = curved_tets(static_cast<int>(state.range(0)), 2, 0.15);
+  run(state, mesh);
+}
+BENCHMARK(BM_CheckCurvedTetP2)->Args({55, 1})->Args({55, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Separate random elements of one Gmsh type (range 2), range 0 of them.
+void BM_CheckCurvedType(benchmark::State& state) {
+  const Mesh mesh = random_curved_block(*find_element_type(static_cast<int>(state.range(2))),
+                                        static_cast<std::size_t>(state.range(0)), 0.08);
+  run(state, mesh);
+}
+// hexahedra of order 2 (27 nodes, type 12) and 3 (64 nodes, type 92); pyramids of order 2
+// (14 nodes, type 19)
+BENCHMARK(BM_CheckCurvedType)
+    ->ArgsProduct({{100000}, {1, 2}, {12, 92, 19}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace quadval

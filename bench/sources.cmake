@@ -3,5 +3,6 @@ list(APPEND QUADVAL_BENCH_SOURCES
   io_bench.cpp
   pyramid_bench.cpp
   jacobian_bench.cpp
+  mu_bench.cpp
   lookahead_bench.cpp
 )

@@ -16,11 +16,15 @@
 ///
 /// All matrices are computed once per key in exact rational arithmetic (GMP), then rounded
 /// to the nearest double; subdivision matrices are dyadic and exact in double. Bases are
-/// built once, immutable and shared by all threads (STYLE.md §7).
+/// built once, immutable and shared by all threads (STYLE.md §7). The Lagrange-to-Bézier
+/// matrix (an exact inverse, cubic in the factor size) is built on first use only: the
+/// Jacobian coefficients of the six Lagrange families come from Bernstein products
+/// (src/analysis/jacobian_product.hpp) and never need it.
 
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -63,17 +67,22 @@ class BernsteinSimplex {
   void evaluate(std::span<const double> xi, std::span<double> values) const;
 
   /// T (size x size, row-major): Bézier coefficients = T * values at the points (eq. 18),
-  /// each entry the double nearest to the exact rational.
-  std::span<const double> lagrange_to_bezier() const noexcept { return to_bezier_; }
+  /// each entry the double nearest to the exact rational. Built on first use (thread-safe).
+  std::span<const double> lagrange_to_bezier() const;
   /// The same matrix transposed (column-major), for vectorised products.
-  std::span<const double> lagrange_to_bezier_transposed() const noexcept { return to_bezier_t_; }
+  std::span<const double> lagrange_to_bezier_transposed() const;
   /// max_i sum_j |T_ij| of the exact T, rounded up: how much an error in the samples can
   /// grow in the coefficients.
-  double lagrange_to_bezier_norm() const noexcept { return to_bezier_norm_; }
+  double lagrange_to_bezier_norm() const;
+  /// V = T^-1 (size x size, row-major): values at the points = V * Bézier coefficients,
+  /// V_ki = B_i(point k), each entry the double nearest to the exact rational. Entries are
+  /// nonnegative and each exact row sums to 1 (partition of unity, eq. 14).
+  std::span<const double> bezier_to_lagrange() const noexcept { return to_lagrange_; }
+  std::span<const double> bezier_to_lagrange_transposed() const noexcept { return to_lagrange_t_; }
   /// The exact T and other rational data (src/bezier/bezier_exact.hpp; GMP stays out
-  /// of the public headers).
+  /// of the public headers). Building it inverts the collocation matrix on first use.
   struct Exact;
-  const Exact& exact() const noexcept { return *exact_; }
+  const Exact& exact() const;
 
   /// 2^d children: the line halves, the 4 triangles of the midpoint split, the 8
   /// tetrahedra of the midpoint split (octahedron cut along the diagonal m02-m13).
@@ -92,9 +101,12 @@ class BernsteinSimplex {
   int dim_;
   int degree_;
   std::vector<std::array<int, 4>> alphas_;
+  void build_to_bezier() const;
   std::vector<bool> vertex_;
-  std::vector<double> to_bezier_, to_bezier_t_;
-  double to_bezier_norm_ = 0;
+  mutable std::once_flag to_bezier_once_;
+  mutable std::vector<double> to_bezier_, to_bezier_t_;
+  mutable double to_bezier_norm_ = 0;
+  std::vector<double> to_lagrange_, to_lagrange_t_;
   std::unique_ptr<Exact> exact_;
   std::vector<std::array<std::array<int, 4>, 4>> children_;
   std::vector<double> subdivision_, subdivision_t_;  // num_children blocks of size*size
@@ -114,10 +126,13 @@ struct FactorDegree {
 std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int order);
 
 /// Highest geometric order whose Jacobian space we build, per family: lines 10 (every
-/// order Gmsh defines), triangles and quadrangles 6, tetrahedra 4, prisms and
-/// hexahedra 3. The limit is the conditioning of the equispaced Lagrange-to-Bézier
-/// conversion in double precision (see bezier_basis.cpp), not memory. 0 for families not
-/// handled (pyramids, polygons...).
+/// order Gmsh defines), triangles 9, quadrangles 8, tetrahedra 4, prisms and hexahedra 4.
+/// The Jacobian coefficients come from Bernstein products of the geometry's control
+/// points (src/analysis/jacobian_product.hpp), not from the J space's ill-conditioned
+/// conversion; the limits are the a priori rounding bound of the geometry's equispaced
+/// conversion (2D beyond these orders: bounds too wide to decide random curved elements)
+/// and memory (tetrahedra of order 5: a 455-coefficient factor, 8 x 455^2 subdivision
+/// entries). Pyramids: kPyramidMaxOrder (Paper IV, sampled). 0 for other families.
 int max_supported_order(ElementFamily family) noexcept;
 
 /// The Bézier basis of the Jacobian determinant space of (family, order p): a tensor
@@ -154,10 +169,20 @@ class BezierBasis {
   void to_bezier_batch(const double* samples, std::size_t count, double* coeffs,
                        double* scratch) const;
   /// Product of the factor norms (rounded up): |exact T| row-sum bound of the whole T.
-  double to_bezier_norm() const noexcept { return to_bezier_norm_; }
+  /// Computed on first use (builds every factor's T).
+  double to_bezier_norm() const;
   /// Rounding of to_bezier: |computed - exact T applied to the same doubles| <=
   /// to_bezier_rounding() * to_bezier_norm() * max|samples| (entrywise).
   double to_bezier_rounding() const noexcept { return to_bezier_rounding_; }
+
+  /// Values at the points from Bézier coefficients (V = T^-1, factor by factor), for
+  /// `count` elements at once, layout as to_bezier_batch's.
+  /// @pre coeffs, samples: size() * count; scratch: 2 * size() * count
+  void from_bezier_batch(const double* coeffs, std::size_t count, double* samples,
+                         double* scratch) const;
+  /// Rounding of from_bezier_batch: |computed - exact V applied to the same doubles| <=
+  /// from_bezier_rounding() * max|coeffs| (V >= 0 with rows summing to 1, rounded entries).
+  double from_bezier_rounding() const noexcept { return from_bezier_rounding_; }
 
   int num_children() const noexcept { return num_children_; }
   /// Child coefficients of child q (0 <= q < num_children()): factor children
@@ -182,7 +207,9 @@ class BezierBasis {
   int num_children_ = 1;
   std::vector<const BernsteinSimplex*> factors_;
   std::vector<int> vertex_indices_;
-  double to_bezier_norm_ = 1;
+  mutable std::once_flag norm_once_;
+  mutable double to_bezier_norm_ = 1;
+  double from_bezier_rounding_ = 0;
   double to_bezier_rounding_ = 0;
   double subdivision_rounding_ = 0;
 };

@@ -2,7 +2,9 @@
 /// Mesh-wide Jacobian check (`quadval check`): certified bounds for every element of the
 /// mesh's highest dimension, in parallel, with the summary of Paper III §5 (counts per
 /// answer and type, worst elements, histogram, the stage table of Table 2) and the
-/// per-element outputs (CSV, JSON, mesh fields for VTU/MSH).
+/// per-element outputs (CSV, JSON, mesh fields for VTU/MSH); optionally the certified
+/// quality measures mu (mu_bounds.hpp, Paper V) and the scaled Jacobian
+/// (scaled_jacobian.hpp).
 ///
 /// Results do not depend on the thread count: elements are processed in fixed chunks
 /// and every element's computation is sequential and deterministic.
@@ -17,6 +19,7 @@
 
 #include "quadval/jacobian_bounds.hpp"
 #include "quadval/mesh.hpp"
+#include "quadval/quality_bounds.hpp"
 
 namespace quadval {
 
@@ -24,13 +27,27 @@ enum class CheckMeasure : std::uint8_t {
   validity,    ///< settle the sign of min J (fastest)
   jacobian,    ///< bounds on min J and max J within the tolerance
   distortion,  ///< as jacobian, plus the distortion min J / J_straight (Paper III eq. 3)
+  mu,               ///< validity, plus certified bounds on mu (mu_bounds.hpp)
+  scaled_jacobian,  ///< validity, plus certified bounds on the scaled Jacobian
+  all,              ///< distortion (jacobian bounds included), mu and the scaled Jacobian
 };
+
+/// "validity", "jacobian", "distortion", "mu", "scaled-jacobian", "all" (the CLI's names).
+const char* check_measure_name(CheckMeasure m) noexcept;
+/// Whether a measure includes mu, the scaled Jacobian, bounds on min/max J, distortion.
+bool measures_mu(CheckMeasure m) noexcept;
+bool measures_scaled_jacobian(CheckMeasure m) noexcept;
+bool measures_jacobian_range(CheckMeasure m) noexcept;
+bool measures_distortion(CheckMeasure m) noexcept;
 
 struct CheckOptions {
   CheckMeasure measure = CheckMeasure::validity;
   double rel_tol = 1e-2;  ///< see BoundsOptions
   double abs_tol = 0;
   int max_subdivisions = 1000;
+  /// Absolute tolerance of mu and the scaled Jacobian (both at most 1), and their
+  /// subdivision limit (max_subdivisions).
+  double quality_abs_tol = 1e-2;
   int threads = 0;  ///< 0: OpenMP's default
   /// Called now and then from the calling thread with (elements done, total).
   std::function<void(std::size_t, std::size_t)> progress;
@@ -47,6 +64,20 @@ struct ElementCheck {
   double ratio_lower = std::nan("");
   /// jmin_lower / javg (javg the mean of J): NaN when javg <= 0.
   double jmin_over_javg = std::nan("");
+  /// Bounds on mu and on the scaled Jacobian: NaN unless computed (measure mu,
+  /// scaled_jacobian or all, and the type supported).
+  QualityBounds mu{std::nan(""), std::nan(""), 0, false};
+  QualityBounds sj{std::nan(""), std::nan(""), 0, false};
+};
+
+/// Per quality measure (mu, scaled Jacobian): how many elements got bounds, how many were
+/// skipped (type or order not supported, or the element itself skipped), how many stopped
+/// at the subdivision limit before the tolerance.
+struct QualityCounts {
+  std::size_t computed = 0;
+  std::size_t skipped = 0;
+  std::size_t tolerance_not_met = 0;
+  std::map<int, std::size_t> skipped_types;  ///< Gmsh type id -> skipped count
 };
 
 /// Paper III Table 2: how many elements each stage decided and the time it took.
@@ -67,6 +98,7 @@ struct CheckReport {
   std::map<int, std::array<std::size_t, 4>> counts;
   std::vector<StageRow> stages;
   std::size_t exact_fallbacks = 0;
+  QualityCounts mu_counts, sj_counts;  ///< only for measures that include them
   double seconds = 0;                 ///< wall time of the analysis
   int threads = 1;
 
@@ -74,6 +106,9 @@ struct CheckReport {
   std::size_t skipped() const;
   /// Indices of the analysed elements, worst first (lowest ratio_lower or distortion).
   std::vector<std::size_t> worst(std::size_t n) const;
+  /// Indices of the elements with mu (sj = false) or scaled-Jacobian (sj = true) bounds,
+  /// worst first by their lower bound (ties by tag).
+  std::vector<std::size_t> worst_quality(std::size_t n, bool sj) const;
 };
 
 /// Analyses every element of the mesh's highest dimension.
@@ -81,21 +116,28 @@ struct CheckReport {
 CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options,
                        const std::string& file = "");
 
-/// Terminal summary: counts per answer and type, stage table, histogram, worst elements.
+/// Terminal summary: counts per answer and type, stage table, histogram, worst elements;
+/// for mu and the scaled Jacobian also min/mean of the lower bounds, a histogram, the
+/// worst elements and the skipped counts.
 std::string format_check_summary(const CheckReport& report, std::size_t worst = 10);
 
 /// Per-element CSV: header row, then one row per element of the analysed dimension:
 /// tag,type,validity,jmin_lower,jmin_upper,jmax_lower,jmax_upper,distortion_lower,
-/// subdivisions,distortion_upper,jmin_over_javg,ratio_lower,stage,exact
-/// (validity is valid, invalid, undetermined or skipped; type is the Gmsh type id).
+/// subdivisions,distortion_upper,jmin_over_javg,ratio_lower,stage,exact,
+/// mu_lower,mu_upper,sj_lower,sj_upper
+/// (validity is valid, invalid, undetermined or skipped; type is the Gmsh type id; nan
+/// where a value was not computed).
 std::string check_csv(const CheckReport& report);
 
-/// JSON: {"summary": {...counts, stages...}, "elements": [{...per element...}]}.
+/// JSON: {"summary": {...counts, stages, and "mu" / "scaled_jacobian": {computed,
+/// skipped, tolerance_not_met, worst_tags} when measured...}, "elements": [{...per
+/// element, with "mu" / "sj": {lower, upper, subdivisions, tolerance_met} when computed}]}.
 std::string check_json(const CheckReport& report);
 
 /// Per-element fields for write_mesh (one value per element of the whole mesh, in block
 /// order; NaN for elements not analysed): validity (1 valid, 0 undetermined, -1 invalid,
-/// NaN skipped), jmin_lower, jmin_upper, ratio_lower, distortion_lower.
+/// NaN skipped), jmin_lower, jmin_upper, ratio_lower, distortion_lower, and mu_lower /
+/// sj_lower when the measure includes them.
 std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh& mesh,
                                                                       const CheckReport& report);
 

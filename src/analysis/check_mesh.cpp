@@ -9,14 +9,19 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <span>
+#include <utility>
 
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "analysis/linear_jacobian.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/scaled_jacobian_space.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
+#include "quadval/mu_bounds.hpp"
+#include "quadval/scaled_jacobian.hpp"
 
 namespace quadval {
 namespace {
@@ -34,6 +39,7 @@ struct ThreadStats {
   std::vector<StageRow> stages;
   std::size_t exact = 0;
   std::map<int, std::array<std::size_t, 4>> counts;  // as CheckReport::counts
+  QualityCounts mu, sj;
   void add(int stage, Validity v, double seconds) {
     const auto row = static_cast<std::size_t>(stage < 0 ? 0 : stage);
     if (stages.size() <= row) stages.resize(row + 1);
@@ -75,10 +81,16 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   }
 
   BoundsOptions bo;
-  bo.goal = options.measure == CheckMeasure::validity ? BoundsGoal::validity : BoundsGoal::measure;
+  bo.goal = measures_jacobian_range(options.measure) ? BoundsGoal::measure : BoundsGoal::validity;
   bo.rel_tol = options.rel_tol;
   bo.abs_tol = options.abs_tol;
   bo.max_subdivisions = options.max_subdivisions;
+
+  const bool want_mu = measures_mu(options.measure);
+  const bool want_sj = measures_scaled_jacobian(options.measure);
+  QualityOptions qo;
+  qo.abs_tol = options.quality_abs_tol;
+  qo.max_subdivisions = options.max_subdivisions;
 
   // First-order fast path (linear_jacobian.hpp): validity only; measuring refines further.
   const bool fast_path = options.measure == CheckMeasure::validity;
@@ -115,7 +127,7 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(omp_get_thread_num())];
-    std::vector<double> nodes, samples, errors, transposed, coeffs_t, coeffs, scratch, soa;
+    std::vector<double> nodes, errors, coeffs, soa;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
 #pragma omp for schedule(dynamic, 1)
@@ -130,16 +142,39 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
           ec.type = &type;
         }
         const LinearKind fast = fast_path ? linear_kind(type, report.planar) : LinearKind::none;
+        if (!jacobian_supported(type))  // skipped elements are skipped for mu and sj too
+          for (QualityCounts* qc : {want_mu ? &st.mu : nullptr, want_sj ? &st.sj : nullptr})
+            if (qc) {
+              qc->skipped += ch.count;
+              qc->skipped_types[type.gmsh_id] += ch.count;
+            }
         if (jacobian_supported(type)) {
           const auto nn = static_cast<std::size_t>(type.num_nodes);
+          // mu or the scaled Jacobian of one element, or a skip said so.
+          const auto quality = [&](bool supported, QualityBounds& out, QualityCounts& qc, const double* xe,
+                                   auto bounds_of) {
+            if (!supported) {
+              ++qc.skipped;
+              ++qc.skipped_types[type.gmsh_id];
+              return;
+            }
+            out = bounds_of(type, std::span<const double>(xe, nn * 3), qo, report.planar);
+            ++qc.computed;
+            if (!out.tolerance_met) ++qc.tolerance_not_met;
+          };
           // What every analysed element gets once its bounds are known.
           const auto finish = [&](ElementCheck& ec, const double* xe, double seconds) {
             ec.analysed = true;
             const JacobianBounds& b = ec.bounds;
             if (b.jmax_upper > 0) ec.ratio_lower = next_down(b.jmin_lower / b.jmax_upper);
             if (b.javg > 0) ec.jmin_over_javg = b.jmin_lower / b.javg;
-            if (options.measure == CheckMeasure::distortion)
+            if (measures_distortion(options.measure))
               ec.distortion = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
+            if (want_mu) quality(mu_supported(type), ec.mu, st.mu, xe, mu_bounds);
+            if (want_sj)
+              quality(scaled_jacobian_supported(type), ec.sj, st.sj, xe,
+                      [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
+                                       bool planar) { return scaled_jacobian_bounds_given(t, x, q, planar, v); });
             if (b.exact) ++st.exact;
             st.add(b.stage, b.validity, seconds);
           };
@@ -170,19 +205,22 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
               }
               const double te = now_seconds();
               const JacobianSpace& space = jacobian_space(type);
-              samples.resize(static_cast<std::size_t>(space.num_samples()));
+              coeffs.resize(static_cast<std::size_t>(space.basis().size()));
               for (std::size_t k = 0; k < nn; ++k)
                 for (std::size_t j = 0; j < 3; ++j)
                   nodes[k * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
-              jacobian_samples(space, SampleMap::curved, nodes.data(), 1, report.planar,
-                               samples.data(), errors.data(), ws.sample_scratch);
-              ec.bounds = bounds_from_samples(space, samples.data(), errors[0], nodes.data(),
-                                              report.planar, bo, ws);
+              jacobian_coefficients(space, nodes.data(), 1, report.planar, coeffs.data(),
+                                    errors.data(), ws.sample_scratch.product);
+              ec.bounds = bounds_from_coefficients(space, coeffs.data(), errors[0], nodes.data(),
+                                                   report.planar, bo, ws);
               finish(ec, nodes.data(), share + (now_seconds() - te));
             }
           } else {
+            // The product path (jacobian_product.hpp): the chunk's Bézier coefficients of J
+            // straight from its nodes, then each element's bounds exactly as jacobian_bounds
+            // computes them (bit-identical; tests/analysis/jacobian_batch_test.cpp).
             const JacobianSpace& space = jacobian_space(type);
-            const auto s = static_cast<std::size_t>(space.num_samples());
+            const auto s = static_cast<std::size_t>(space.basis().size());
             nodes.resize(ch.count * nn * 3);
             for (std::size_t i = 0; i < ch.count; ++i) {
               const auto conn = blk.element(ch.first + i);
@@ -190,28 +228,18 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
                 for (std::size_t j = 0; j < 3; ++j)
                   nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
             }
-            samples.resize(ch.count * s);
+            coeffs.resize(ch.count * s);
             errors.resize(ch.count);
             const double ts = now_seconds();
-            jacobian_samples(space, SampleMap::curved, nodes.data(), ch.count, report.planar,
-                             samples.data(), errors.data(), ws.sample_scratch);
-            // First Bézier coefficients of the whole chunk: one matrix-matrix product.
-            transposed.resize(ch.count * s);
-            for (std::size_t i = 0; i < ch.count; ++i)
-              for (std::size_t k = 0; k < s; ++k) transposed[k * ch.count + i] = samples[i * s + k];
-            coeffs_t.resize(ch.count * s);
-            scratch.resize(2 * ch.count * s);
-            space.basis().to_bezier_batch(transposed.data(), ch.count, coeffs_t.data(), scratch.data());
-            coeffs.resize(ch.count * s);
-            for (std::size_t i = 0; i < ch.count; ++i)
-              for (std::size_t k = 0; k < s; ++k) coeffs[i * s + k] = coeffs_t[k * ch.count + i];
+            jacobian_coefficients(space, nodes.data(), ch.count, report.planar, coeffs.data(),
+                                  errors.data(), ws.sample_scratch.product);
             const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
             for (std::size_t i = 0; i < ch.count; ++i) {
               const double te = now_seconds();
               ElementCheck& ec = report.elements[ch.out + i];
               const double* xe = nodes.data() + i * nn * 3;
-              ec.bounds = bounds_from_samples(space, samples.data() + i * s, errors[i], xe,
-                                              report.planar, bo, ws, coeffs.data() + i * s);
+              ec.bounds = bounds_from_coefficients(space, coeffs.data() + i * s, errors[i], xe,
+                                                   report.planar, bo, ws);
               finish(ec, xe, batch_share + (now_seconds() - te));
             }
           }
@@ -236,6 +264,12 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
 
   for (const ThreadStats& st : stats) {
     report.exact_fallbacks += st.exact;
+    for (auto [from, to] : {std::pair{&st.mu, &report.mu_counts}, std::pair{&st.sj, &report.sj_counts}}) {
+      to->computed += from->computed;
+      to->skipped += from->skipped;
+      to->tolerance_not_met += from->tolerance_not_met;
+      for (const auto& [id, n] : from->skipped_types) to->skipped_types[id] += n;
+    }
     for (const auto& [id, c] : st.counts)
       for (std::size_t k = 0; k < 4; ++k) report.counts[id][k] += c[k];
     if (report.stages.size() < st.stages.size()) report.stages.resize(st.stages.size());
@@ -263,9 +297,24 @@ std::size_t CheckReport::skipped() const {
   return n;
 }
 
+std::vector<std::size_t> CheckReport::worst_quality(std::size_t n, bool sj) const {
+  std::vector<std::size_t> idx;
+  const auto key = [&](std::size_t i) { return sj ? elements[i].sj.lower : elements[i].mu.lower; };
+  for (std::size_t i = 0; i < elements.size(); ++i)
+    if (!std::isnan(key(i))) idx.push_back(i);
+  const std::size_t m = std::min(n, idx.size());
+  std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m), idx.end(),
+                    [&](std::size_t a, std::size_t b) {
+                      const double ka = key(a), kb = key(b);
+                      return ka != kb ? ka < kb : elements[a].tag < elements[b].tag;
+                    });
+  idx.resize(m);
+  return idx;
+}
+
 std::vector<std::size_t> CheckReport::worst(std::size_t n) const {
   std::vector<std::size_t> idx;
-  const bool by_distortion = measure == CheckMeasure::distortion;
+  const bool by_distortion = measures_distortion(measure);
   const auto key = [&](std::size_t i) {
     const ElementCheck& e = elements[i];
     const double k = by_distortion ? e.distortion.lower : e.ratio_lower;

@@ -3,7 +3,10 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
+#include <tuple>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "quadval/check_report.hpp"
@@ -11,14 +14,7 @@
 namespace quadval {
 namespace {
 
-const char* measure_name(CheckMeasure m) {
-  switch (m) {
-    case CheckMeasure::validity: return "validity";
-    case CheckMeasure::jacobian: return "jacobian";
-    case CheckMeasure::distortion: return "distortion";
-  }
-  return "?";
-}
+const char* measure_name(CheckMeasure m) { return check_measure_name(m); }
 
 std::string num(double x) { return std::isnan(x) ? "nan" : fmt::format("{:.17g}", x); }
 
@@ -28,10 +24,89 @@ const char* answer(const ElementCheck& e) {
 
 // The scale-free quality the histogram and the worst list use.
 double quality(const CheckReport& r, const ElementCheck& e) {
-  return r.measure == CheckMeasure::distortion ? e.distortion.lower : e.ratio_lower;
+  return measures_distortion(r.measure) ? e.distortion.lower : e.ratio_lower;
+}
+
+// Histogram lines of values in [-1, 1] (bins of 0.1 from 0, one bin below 0).
+void histogram(std::string& out, const std::vector<double>& values) {
+  static constexpr double kEdges[] = {-INFINITY, 0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, INFINITY};
+  std::array<std::size_t, 11> bins{};
+  for (double q : values)
+    for (std::size_t b = 0; b < bins.size(); ++b)
+      if (q >= kEdges[b] && q < kEdges[b + 1]) ++bins[b];
+  for (std::size_t b = 0; b < bins.size(); ++b) {
+    const std::string label = b == 0 ? "< 0" : b + 1 == bins.size() ? ">= 0.9" : fmt::format("[{:.1f}, {:.1f})", kEdges[b], kEdges[b + 1]);
+    const std::size_t width = values.empty() ? 0 : (bins[b] * 40 + values.size() - 1) / values.size();
+    out += fmt::format("  {:>12} {:>9} {}\n", label, bins[b], std::string(width, '#'));
+  }
+}
+
+// The summary section of mu (sj = false) or the scaled Jacobian (sj = true).
+void quality_section(std::string& out, const CheckReport& r, bool sj, std::size_t worst) {
+  const QualityCounts& qc = sj ? r.sj_counts : r.mu_counts;
+  const char* name = sj ? "scaled Jacobian" : "mu";
+  std::vector<double> lows;
+  double sum = 0;
+  for (const ElementCheck& e : r.elements) {
+    const double lo = sj ? e.sj.lower : e.mu.lower;
+    if (std::isnan(lo)) continue;
+    lows.push_back(lo);
+    sum += lo;
+  }
+  out += fmt::format("  {} ({}): computed {}, skipped {}, tolerance not met {}\n", name,
+                     sj ? "min of det J / product of column norms, corner frames for simplices"
+                        : "min of sqrt(lambda_min / lambda_max) of W^T W, Paper V",
+                     qc.computed, qc.skipped, qc.tolerance_not_met);
+  for (const auto& [id, n] : qc.skipped_types) {
+    const ElementType* t = find_element_type(id);
+    out += fmt::format("  note: {} {} skipped for {}: type or order not supported\n", n, t ? t->name : "?", name);
+  }
+  if (lows.empty()) {
+    out += "\n";
+    return;
+  }
+  const ElementCheck& lowest = r.elements[r.worst_quality(1, sj).front()];
+  out += fmt::format("  {} lower bounds: min {:.6g} (element {}), mean {:.6g}\n", name,
+                     sj ? lowest.sj.lower : lowest.mu.lower, lowest.tag, sum / static_cast<double>(lows.size()));
+  out += fmt::format("  histogram of the {} lower bounds\n", name);
+  histogram(out, lows);
+  const auto wl = r.worst_quality(worst, sj);
+  if (!wl.empty()) {
+    out += fmt::format("  worst {} elements by {}\n", wl.size(), name);
+    out += fmt::format("  {:>10} {:<22} {:<13} {:>13} {:>13} {:>8}\n", "tag", "type", "validity", "lower", "upper", "subdiv");
+    for (std::size_t i : wl) {
+      const ElementCheck& e = r.elements[i];
+      const QualityBounds& q = sj ? e.sj : e.mu;
+      out += fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>8}\n", e.tag, e.type->name, answer(e), q.lower,
+                         q.upper, q.subdivisions);
+    }
+  }
+  out += "\n";
 }
 
 }  // namespace
+
+const char* check_measure_name(CheckMeasure m) noexcept {
+  switch (m) {
+    case CheckMeasure::validity: return "validity";
+    case CheckMeasure::jacobian: return "jacobian";
+    case CheckMeasure::distortion: return "distortion";
+    case CheckMeasure::mu: return "mu";
+    case CheckMeasure::scaled_jacobian: return "scaled-jacobian";
+    case CheckMeasure::all: return "all";
+  }
+  return "?";
+}
+bool measures_mu(CheckMeasure m) noexcept { return m == CheckMeasure::mu || m == CheckMeasure::all; }
+bool measures_scaled_jacobian(CheckMeasure m) noexcept {
+  return m == CheckMeasure::scaled_jacobian || m == CheckMeasure::all;
+}
+bool measures_jacobian_range(CheckMeasure m) noexcept {
+  return m == CheckMeasure::jacobian || m == CheckMeasure::distortion || m == CheckMeasure::all;
+}
+bool measures_distortion(CheckMeasure m) noexcept {
+  return m == CheckMeasure::distortion || m == CheckMeasure::all;
+}
 
 std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   std::string out;
@@ -52,10 +127,8 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   for (const auto& [id, c] : r.counts)
     if (c[3] > 0) {
       const ElementType* t = find_element_type(id);
-      line(fmt::format("  note: {} {} not analysed: {}", c[3], t ? t->name : "?",
-                       t && t->family == ElementFamily::pyramid
-                           ? "pyramids are not analysed yet (a separate space, Paper IV; issue 4)"
-                           : "order beyond the supported ones (max_supported_order)"));
+      line(fmt::format("  note: {} {} not analysed: type or order beyond the supported ones "
+                       "(max_supported_order)", c[3], t ? t->name : "?"));
     }
   line("");
   line("  stage table (Paper III Table 2; time = CPU seconds over threads)");
@@ -67,7 +140,7 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   line("");
 
   // Histogram of the scale-free quality.
-  const char* qname = r.measure == CheckMeasure::distortion ? "distortion lower bound (min J / J_straight)"
+  const char* qname = measures_distortion(r.measure) ? "distortion lower bound (min J / J_straight)"
                                                             : "min J / max J lower bound";
   static constexpr double kEdges[] = {-INFINITY, 0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, INFINITY};
   std::array<std::size_t, 11> bins{};
@@ -96,12 +169,20 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   if (!w.empty()) {
     line(fmt::format("  worst {} elements", w.size()));
     line(fmt::format("  {:>10} {:<22} {:<13} {:>13} {:>13} {:>11}", "tag", "type", "validity", "jmin_lower",
-                     "jmin_upper", r.measure == CheckMeasure::distortion ? "distortion" : "ratio"));
+                     "jmin_upper", measures_distortion(r.measure) ? "distortion" : "ratio"));
     for (std::size_t i : w) {
       const ElementCheck& e = r.elements[i];
       line(fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>11.5g}", e.tag, e.type->name, answer(e),
                        e.bounds.jmin_lower, e.bounds.jmin_upper, quality(r, e)));
     }
+  }
+  const bool mu = measures_mu(r.measure), sj = measures_scaled_jacobian(r.measure);
+  if (mu || sj) {
+    line("");
+    if (mu) quality_section(out, r, false, worst);
+    if (sj) quality_section(out, r, true, worst);
+    line("  note: certified bounds (lower <= min over the element <= upper, within --tol). Gmsh's");
+    line("  AnalyseCurvedMesh ICN/IGE are related but not equal measures, and not certified bounds.");
   }
   return out;
 }
@@ -109,17 +190,18 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
 std::string check_csv(const CheckReport& r) {
   std::string out =
       "tag,type,validity,jmin_lower,jmin_upper,jmax_lower,jmax_upper,distortion_lower,subdivisions,"
-      "distortion_upper,jmin_over_javg,ratio_lower,stage,exact\n";
+      "distortion_upper,jmin_over_javg,ratio_lower,stage,exact,mu_lower,mu_upper,sj_lower,sj_upper\n";
   for (const ElementCheck& e : r.elements) {
     const JacobianBounds& b = e.bounds;
     if (!e.analysed) {
-      out += fmt::format("{},{},skipped,nan,nan,nan,nan,nan,0,nan,nan,nan,-1,0\n", e.tag, e.type->gmsh_id);
+      out += fmt::format("{},{},skipped,nan,nan,nan,nan,nan,0,nan,nan,nan,-1,0,nan,nan,nan,nan\n", e.tag, e.type->gmsh_id);
       continue;
     }
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag, e.type->gmsh_id, answer(e),
+    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag, e.type->gmsh_id, answer(e),
                        num(b.jmin_lower), num(b.jmin_upper), num(b.jmax_lower), num(b.jmax_upper),
                        num(e.distortion.lower), b.subdivisions, num(e.distortion.upper),
-                       num(e.jmin_over_javg), num(e.ratio_lower), b.stage, b.exact ? 1 : 0);
+                       num(e.jmin_over_javg), num(e.ratio_lower), b.stage, b.exact ? 1 : 0, num(e.mu.lower),
+                       num(e.mu.upper), num(e.sj.lower), num(e.sj.upper));
   }
   return out;
 }
@@ -146,6 +228,16 @@ std::string check_json(const CheckReport& r) {
                                              {"undetermined", c[2]}, {"skipped", c[3]}};
   }
   summary["types"] = types;
+  for (const auto& [key, qc, on] : {std::tuple{"mu", &r.mu_counts, measures_mu(r.measure)},
+                                    std::tuple{"scaled_jacobian", &r.sj_counts, measures_scaled_jacobian(r.measure)}}) {
+    if (!on) continue;
+    json q = {{"computed", qc->computed}, {"skipped", qc->skipped}, {"tolerance_not_met", qc->tolerance_not_met}};
+    const auto w = r.worst_quality(10, std::string(key) != "mu");
+    json tags = json::array();
+    for (std::size_t i : w) tags.push_back(r.elements[i].tag);
+    q["worst_tags"] = tags;
+    summary[key] = q;
+  }
   json stages = json::array();
   for (const StageRow& s : r.stages)
     stages.push_back({{"stage", s.name}, {"valid", s.valid}, {"invalid", s.invalid}, {"cpu_seconds", s.seconds}});
@@ -166,6 +258,8 @@ std::string check_json(const CheckReport& r) {
       je["subdivisions"] = b.subdivisions;
       je["stage"] = b.stage;
       je["exact"] = b.exact;
+      if (!std::isnan(e.mu.lower)) je["mu"] = {{"lower", e.mu.lower}, {"upper", e.mu.upper}, {"subdivisions", e.mu.subdivisions}, {"tolerance_met", e.mu.tolerance_met}};
+      if (!std::isnan(e.sj.lower)) je["sj"] = {{"lower", e.sj.lower}, {"upper", e.sj.upper}, {"subdivisions", e.sj.subdivisions}, {"tolerance_met", e.sj.tolerance_met}};
     }
     elements.push_back(std::move(je));
   }
@@ -175,12 +269,13 @@ std::string check_json(const CheckReport& r) {
 std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh& mesh,
                                                                       const CheckReport& r) {
   std::vector<std::pair<std::string, std::vector<double>>> f = {
-      {"validity", {}}, {"jmin_lower", {}}, {"jmin_upper", {}}, {"ratio_lower", {}}, {"distortion_lower", {}}};
+      {"validity", {}}, {"jmin_lower", {}}, {"jmin_upper", {}}, {"ratio_lower", {}}, {"distortion_lower", {}},
+      {"mu_lower", {}}, {"sj_lower", {}}};
   std::size_t k = 0;
   for (const ElementBlock& b : mesh.blocks) {
     const bool analysed_dim = b.type->dim == r.dimension;
     for (std::size_t e = 0; e < b.size(); ++e) {
-      double v = NAN, lo = NAN, hi = NAN, ratio = NAN, dist = NAN;
+      double v = NAN, lo = NAN, hi = NAN, ratio = NAN, dist = NAN, mu = NAN, sj = NAN;
       if (analysed_dim) {
         const ElementCheck& c = r.elements[k++];
         if (c.analysed) {
@@ -189,6 +284,8 @@ std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh
           hi = c.bounds.jmin_upper;
           ratio = c.ratio_lower;
           dist = c.distortion.lower;
+          mu = c.mu.lower;
+          sj = c.sj.lower;
         }
       }
       f[0].second.push_back(v);
@@ -196,8 +293,13 @@ std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh
       f[2].second.push_back(hi);
       f[3].second.push_back(ratio);
       f[4].second.push_back(dist);
+      f[5].second.push_back(mu);
+      f[6].second.push_back(sj);
     }
   }
+  // mu_lower and sj_lower only when the measure computed them.
+  if (!measures_scaled_jacobian(r.measure)) f.erase(f.begin() + 6);
+  if (!measures_mu(r.measure)) f.erase(f.begin() + 5);
   return f;
 }
 

@@ -57,48 +57,29 @@ bool jacobian_bounds_supported(const ElementType& type) noexcept {
   return jacobian_supported(type);
 }
 
-JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* samples,
-                                   double err, const double* nodes, bool planar,
-                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws,
-                                   const double* root_coeffs) {
+namespace {
+
+// Bézier coefficients of J of one element by the product path, into coeffs; their error.
+double product_coefficients(const JacobianSpace& space, SampleMap map, const double* nodes,
+                            bool planar, std::vector<double>& coeffs, BoundsWorkspace::Impl& ws) {
+  coeffs.resize(static_cast<std::size_t>(space.basis().size()));
+  double err = 0;
+  space.product()->coefficients(map, nodes, 1, planar, coeffs.data(), &err, ws.sample_scratch.product);
+  return err;
+}
+
+// Refinement and answer from the first coefficients in ws.coeffs (error err_b), Algorithm
+// 2 lines 3-12 and Algorithm 3. sample_invalid: a value of J <= 0 is already proven;
+// value_upper: the smallest proven value of J so far (an upper bound of min J).
+JacobianBounds bounds_from_first_coefficients(const JacobianSpace& space, double err_b,
+                                              bool sample_invalid, double value_upper,
+                                              const double* nodes, bool planar,
+                                              const BoundsOptions& options,
+                                              BoundsWorkspace::Impl& ws) {
   const BezierBasis& basis = space.basis();
   const auto s = static_cast<std::size_t>(basis.size());
   JacobianBounds out;
-
-  // Stage 0 (Algorithm 2, lines 3-4): a sample is a value of J.
-  bool sample_invalid = false;
-  for (std::size_t k = 0; k < s; ++k)
-    if (up(samples[k] + err) <= 0) sample_invalid = true;
-
-  // Stage 1: the first Bézier coefficients (eq. 18).
-  ws.coeffs.resize(s);
-  double err_b;
-  if (root_coeffs != nullptr) {
-    std::copy(root_coeffs, root_coeffs + s, ws.coeffs.begin());
-    err_b = coefficient_error(basis, samples, err);
-  } else {
-    err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
-  }
   const bool measuring = options.goal == BoundsGoal::measure;
-  if (measuring || !sample_invalid) {
-    double lo = kInf;
-    for (double c : ws.coeffs) lo = std::min(lo, c);
-    if (measuring || !(down(lo - err_b) > 0)) {
-      // Not settled by the cheap per-element error bound: redo this element with the
-      // per-sample bound (jacobian_samples.cpp), much sharper, before refining.
-      ws.tight_samples.resize(s);
-      double tight_err = 0;
-      jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.tight_samples.data(),
-                       &tight_err, ws.sample_scratch, /*tight=*/true);
-      ws.tight_coeffs.resize(s);
-      const double tight_b = to_bezier_with_error(basis, ws.tight_samples.data(), tight_err,
-                                                  ws.tight_coeffs.data(), ws.scratch);
-      if (tight_b < err_b) {
-        err_b = tight_b;
-        ws.coeffs = ws.tight_coeffs;
-      }
-    }
-  }
   double sum = 0;
   for (double c : ws.coeffs) sum += c;
   out.javg = sum / static_cast<double>(s);
@@ -115,9 +96,7 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
     rmin = refine_minimum(basis, ws.coeffs.data(), err_b, true, tol, options.max_subdivisions, ws);
   }
   out.jmin_lower = rmin.lower;
-  out.jmin_upper = rmin.upper;
-  // Every sample is a value of J, so the smallest is an upper bound of min J too.
-  for (std::size_t k = 0; k < s; ++k) out.jmin_upper = std::min(out.jmin_upper, up(samples[k] + err));
+  out.jmin_upper = std::min(rmin.upper, value_upper);
   out.subdivisions = rmin.subdivisions;
   out.tolerance_met = !measuring || rmin.upper - rmin.lower <= tol;
 
@@ -153,9 +132,11 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
     out.stage = rmin.subdivisions == 0 ? 1 : 1 + rmin.depth;
 
   if (out.validity == Validity::undetermined && rmin.rounding_limited && options.exact_fallback) {
-    const std::vector<mpq_class> exact_samples = exact_jacobian_samples(space, nodes, planar);
-    const ExactRefinement ex =
-        exact_validity(basis, exact_to_bezier(basis, exact_samples), options.max_subdivisions);
+    const std::vector<mpq_class> exact_coeffs =
+        space.product() != nullptr
+            ? space.product()->exact_coefficients(SampleMap::curved, nodes, planar)
+            : exact_to_bezier(basis, exact_jacobian_samples(space, nodes, planar));
+    const ExactRefinement ex = exact_validity(basis, exact_coeffs, options.max_subdivisions);
     out.jmin_lower = std::max(out.jmin_lower, round_down(ex.lower));
     out.jmin_upper = std::min(out.jmin_upper, round_up(ex.upper));
     out.validity = ex.validity;
@@ -166,19 +147,110 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
   return out;
 }
 
+// Stage 0 on coefficients: a vertex coefficient is a value of J.
+bool vertex_value_invalid(const BezierBasis& basis, const double* coeffs, double err,
+                          double& value_upper) {
+  bool invalid = false;
+  for (int v : basis.vertex_indices()) {
+    const double hi = up(coeffs[static_cast<std::size_t>(v)] + err);
+    value_upper = std::min(value_upper, hi);
+    if (hi <= 0) invalid = true;
+  }
+  return invalid;
+}
+
+}  // namespace
+
+JacobianBounds bounds_from_coefficients(const JacobianSpace& space, const double* coeffs,
+                                        double err, const double* nodes, bool planar,
+                                        const BoundsOptions& options, BoundsWorkspace::Impl& ws) {
+  const auto s = static_cast<std::size_t>(space.basis().size());
+  ws.coeffs.assign(coeffs, coeffs + s);
+  double value_upper = kInf;
+  const bool invalid = vertex_value_invalid(space.basis(), coeffs, err, value_upper);
+  return bounds_from_first_coefficients(space, err, invalid, value_upper, nodes, planar, options, ws);
+}
+
+JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* samples,
+                                   double err, const double* nodes, bool planar,
+                                   const BoundsOptions& options, BoundsWorkspace::Impl& ws,
+                                   const double* root_coeffs) {
+  const BezierBasis& basis = space.basis();
+  const auto s = static_cast<std::size_t>(basis.size());
+
+  // Stage 0 (Algorithm 2, lines 3-4): a sample is a value of J.
+  bool sample_invalid = false;
+  double value_upper = kInf;
+  for (std::size_t k = 0; k < s; ++k) {
+    const double hi = up(samples[k] + err);
+    value_upper = std::min(value_upper, hi);
+    if (hi <= 0) sample_invalid = true;
+  }
+
+  // Stage 1: the first Bézier coefficients (eq. 18).
+  double err_b;
+  const bool measuring = options.goal == BoundsGoal::measure;
+  if (!space.has_sample_gradients()) {
+    // No well-conditioned conversion from samples: the product path, from the nodes.
+    err_b = product_coefficients(space, SampleMap::curved, nodes, planar, ws.coeffs, ws);
+    if (vertex_value_invalid(basis, ws.coeffs.data(), err_b, value_upper)) sample_invalid = true;
+  } else {
+    ws.coeffs.resize(s);
+    if (root_coeffs != nullptr) {
+      std::copy(root_coeffs, root_coeffs + s, ws.coeffs.begin());
+      err_b = coefficient_error(basis, samples, err);
+    } else {
+      err_b = to_bezier_with_error(basis, samples, err, ws.coeffs.data(), ws.scratch);
+    }
+    if (measuring || !sample_invalid) {
+      double lo = kInf;
+      for (double c : ws.coeffs) lo = std::min(lo, c);
+      if (measuring || !(down(lo - err_b) > 0)) {
+        // Not settled by the cheap per-element error bound: redo this element with a
+        // sharper bound before refining: the product path (per-coordinate magnitudes,
+        // no conversion norm), or for pyramids the per-sample bound.
+        double tight_b;
+        if (space.product() != nullptr) {
+          tight_b = product_coefficients(space, SampleMap::curved, nodes, planar, ws.tight_coeffs, ws);
+        } else {
+          ws.tight_samples.resize(s);
+          double tight_err = 0;
+          jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.tight_samples.data(),
+                           &tight_err, ws.sample_scratch, /*tight=*/true);
+          ws.tight_coeffs.resize(s);
+          tight_b = to_bezier_with_error(basis, ws.tight_samples.data(), tight_err,
+                                         ws.tight_coeffs.data(), ws.scratch);
+        }
+        if (tight_b < err_b) {
+          err_b = tight_b;
+          ws.coeffs = ws.tight_coeffs;
+        }
+      }
+    }
+  }
+  return bounds_from_first_coefficients(space, err_b, sample_invalid, value_upper, nodes, planar,
+                                        options, ws);
+}
+
 DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,
                                  const JacobianBounds& jb, BoundsWorkspace::Impl& ws) {
   const BezierBasis& basis = space.basis();
   const auto s = static_cast<std::size_t>(basis.size());
   DistortionBounds d{std::nan(""), std::nan("")};
-  // J_straight: samples of the straight-sided element, then its Bézier coefficients.
-  ws.straight_samples.resize(s);
-  ws.straight_coeffs.resize(s);
-  double err_s = 0;
-  jacobian_samples(space, SampleMap::straight, nodes, 1, planar, ws.straight_samples.data(),
-                   &err_s, ws.sample_scratch, /*tight=*/true);
-  const double err_c = to_bezier_with_error(basis, ws.straight_samples.data(), err_s,
-                                            ws.straight_coeffs.data(), ws.scratch);
+  // J_straight: its Bézier coefficients in J's space (the product path; pyramids: samples
+  // of the straight-sided element, then converted).
+  double err_c;
+  if (space.product() != nullptr) {
+    err_c = product_coefficients(space, SampleMap::straight, nodes, planar, ws.straight_coeffs, ws);
+  } else {
+    ws.straight_samples.resize(s);
+    ws.straight_coeffs.resize(s);
+    double err_s = 0;
+    jacobian_samples(space, SampleMap::straight, nodes, 1, planar, ws.straight_samples.data(),
+                     &err_s, ws.sample_scratch, /*tight=*/true);
+    err_c = to_bezier_with_error(basis, ws.straight_samples.data(), err_s,
+                                 ws.straight_coeffs.data(), ws.scratch);
+  }
   const auto& c = ws.straight_coeffs;
   double c_lo = kInf, c_hi = -kInf;
   for (double x : c) {
@@ -199,12 +271,17 @@ DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes
     return d;
   }
   // min J / J_s >= min_i b_i / c_i when every c_i > 0 (J - m J_s has coefficients >= 0).
-  ws.samples.resize(s);
-  double err = 0;
-  jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.samples.data(), &err,
-                   ws.sample_scratch, /*tight=*/true);
-  ws.coeffs.resize(s);
-  const double err_b = to_bezier_with_error(basis, ws.samples.data(), err, ws.coeffs.data(), ws.scratch);
+  double err_b;
+  if (space.product() != nullptr) {
+    err_b = product_coefficients(space, SampleMap::curved, nodes, planar, ws.coeffs, ws);
+  } else {
+    ws.samples.resize(s);
+    double err = 0;
+    jacobian_samples(space, SampleMap::curved, nodes, 1, planar, ws.samples.data(), &err,
+                     ws.sample_scratch, /*tight=*/true);
+    ws.coeffs.resize(s);
+    err_b = to_bezier_with_error(basis, ws.samples.data(), err, ws.coeffs.data(), ws.scratch);
+  }
   double lower = kInf, upper = kInf;
   for (std::size_t i = 0; i < s; ++i) {
     const double ci_lo = down(c[i] - err_c), ci_hi = up(c[i] + err_c);
@@ -231,6 +308,11 @@ JacobianBounds jacobian_bounds(const ElementType& type, std::span<const double> 
             "nodes " << nodes.size() << " for " << type.name);
   const JacobianSpace& space = jacobian_space(type);
   auto& ws = workspace.impl();
+  if (space.product() != nullptr) {
+    std::vector<double>& coeffs = ws.first_coeffs;
+    const double err = product_coefficients(space, SampleMap::curved, nodes.data(), planar, coeffs, ws);
+    return bounds_from_coefficients(space, coeffs.data(), err, nodes.data(), planar, options, ws);
+  }
   ws.samples.resize(static_cast<std::size_t>(space.num_samples()));
   ws.errors.resize(1);
   jacobian_samples(space, SampleMap::curved, nodes.data(), 1, planar, ws.samples.data(),

@@ -23,7 +23,7 @@ struct BoundsWorkspace::Impl {
   };
   SampleScratch sample_scratch;
   std::vector<double> samples, errors, coeffs, scratch, straight_samples, straight_coeffs;
-  std::vector<double> tight_samples, tight_coeffs;
+  std::vector<double> tight_samples, tight_coeffs, first_coeffs;
   std::vector<double> pool;
   std::vector<int> free_slots;
   std::vector<Leaf> heap;
@@ -70,6 +70,25 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
                                    double err, const double* nodes, bool planar,
                                    const BoundsOptions& options, BoundsWorkspace::Impl& ws,
                                    const double* root_coeffs = nullptr);
+
+/// The same from first Bézier coefficients (jacobian_coefficients, or
+/// JacobianProduct::coefficients): stage 0 uses the vertex coefficients (values of J).
+/// @param coeffs basis().size() coefficients of J, each within err of the exact ones
+/// @pre space.product() != nullptr (for the exact fallback)
+JacobianBounds bounds_from_coefficients(const JacobianSpace& space, const double* coeffs,
+                                        double err, const double* nodes, bool planar,
+                                        const BoundsOptions& options, BoundsWorkspace::Impl& ws);
+
+/// Bézier coefficients of J for `count` elements of one type at once (the product path,
+/// jacobian_product.hpp), element-major, with per-element error bounds: what `check`
+/// feeds to bounds_from_coefficients, chunk by chunk.
+/// @param nodes count x #nodes x 3; @param coeffs out: count x basis().size();
+/// @param errors out: count.  @pre space.product() != nullptr
+inline void jacobian_coefficients(const JacobianSpace& space, const double* nodes,
+                                  std::size_t count, bool planar, double* coeffs,
+                                  double* errors, ProductScratch& scratch) {
+  space.product()->coefficients(SampleMap::curved, nodes, count, planar, coeffs, errors, scratch);
+}
 
 /// Distortion bounds (see jacobian_bounds.hpp) of one element with bounds jb.
 DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,

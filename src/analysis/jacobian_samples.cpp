@@ -20,6 +20,7 @@
 #include "analysis/jacobian_samples.hpp"
 
 #include <cstddef>
+#include <algorithm>
 #include <cmath>
 
 #include "quadval/error.hpp"
@@ -59,6 +60,29 @@ std::array<double, 3> reference_direction(const ElementType& type, const double*
 void jacobian_samples(const JacobianSpace& space, SampleMap map, const double* nodes,
                       std::size_t count, bool planar, double* samples, double* errors,
                       SampleScratch& scratch, bool tight) {
+  if (!space.has_sample_gradients()) {
+    // Values of the Bézier form at the points: V has nonnegative rows summing to 1, so a
+    // value errs by at most the coefficients' error plus V's rounding of max|coefficient|.
+    const BezierBasis& basis = space.basis();
+    const auto s = static_cast<std::size_t>(basis.size());
+    scratch.coeffs.resize(s * count);
+    space.product()->coefficients(map, nodes, count, planar, scratch.coeffs.data(), errors,
+                                  scratch.product);
+    scratch.transposed.resize(s * count);
+    for (std::size_t e = 0; e < count; ++e)
+      for (std::size_t k = 0; k < s; ++k) scratch.transposed[k * count + e] = scratch.coeffs[e * s + k];
+    scratch.scratch.resize(2 * s * count);
+    basis.from_bezier_batch(scratch.transposed.data(), count, scratch.coeffs.data(), scratch.scratch.data());
+    for (std::size_t e = 0; e < count; ++e) {
+      double big = 0;
+      for (std::size_t k = 0; k < s; ++k) {
+        samples[e * s + k] = scratch.coeffs[k * count + e];
+        big = std::max(big, std::abs(scratch.transposed[k * count + e]));
+      }
+      errors[e] = (errors[e] * (1 + 4 * kUnit) + basis.from_bezier_rounding() * big) * 1.01;
+    }
+    return;
+  }
   const bool straight = map == SampleMap::straight;
   const int dim = space.dim();
   const auto n_used = static_cast<std::ptrdiff_t>(straight ? space.num_vertices() : space.num_nodes());
@@ -177,6 +201,7 @@ void jacobian_samples(const JacobianSpace& space, SampleMap map, const double* n
 
 std::vector<mpq_class> exact_jacobian_samples(const JacobianSpace& space, const double* nodes,
                                               bool planar) {
+  QV_ASSERT(space.has_sample_gradients(), "no sample gradients for " << space.type().name);
   const int dim = space.dim();
   const auto n = static_cast<std::size_t>(space.num_nodes());
   const auto s = static_cast<std::size_t>(space.num_samples());

@@ -20,16 +20,17 @@ namespace quadval {
 std::array<double, 3> reference_direction(const ElementType& type, const double* nodes,
                                           bool planar) noexcept;
 
-/// Which gradient matrices to use: the element's own, or its straight-sided element's.
-enum class SampleMap { curved, straight };
-
 /// Scratch of jacobian_samples, reused across calls.
 struct SampleScratch {
   std::vector<double> coords;  // #nodes x (3 * count), column-major
   std::vector<double> deriv[3];
+  ProductScratch product;       // spaces without sample gradients
+  std::vector<double> coeffs, transposed, scratch;
 };
 
 /// J at every sample of every element of a batch, and a bound on each element's error.
+/// Spaces without sample gradients (JacobianSpace::has_sample_gradients) evaluate the
+/// product coefficients (jacobian_product.hpp) at the points instead; `tight` is then moot.
 /// @param nodes   count x #nodes x 3 coordinates (Gmsh node order)
 /// @param samples out: count x num_samples (element-major)
 /// @param errors  out: count; |computed - exact| <= errors[e] for every sample of e
@@ -43,6 +44,7 @@ void jacobian_samples(const JacobianSpace& space, SampleMap map, const double* n
 
 /// Exact J at every sample of one element, from its double coordinates as exact rationals.
 /// @param nodes #nodes x 3
+/// @pre space.has_sample_gradients()
 std::vector<mpq_class> exact_jacobian_samples(const JacobianSpace& space, const double* nodes,
                                               bool planar);
 

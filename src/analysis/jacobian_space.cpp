@@ -281,6 +281,19 @@ bool jacobian_supported(const ElementType& type) noexcept {
          type.order <= max_supported_order(type.family);
 }
 
+int sampled_max_order(ElementFamily family) noexcept {
+  switch (family) {
+    case ElementFamily::line: return 10;
+    case ElementFamily::triangle:
+    case ElementFamily::quadrangle: return 6;
+    case ElementFamily::tetrahedron: return 4;
+    case ElementFamily::prism:
+    case ElementFamily::hexahedron: return 3;
+    case ElementFamily::pyramid: return max_supported_order(family);
+    default: return 0;
+  }
+}
+
 JacobianSpace::JacobianSpace(const ElementType& type)
     : type_(&type), basis_(&bezier_basis(type.family, type.order)) {
   QV_ASSERT(jacobian_supported(type), "no Jacobian space for " << type.name);
@@ -289,6 +302,8 @@ JacobianSpace::JacobianSpace(const ElementType& type)
   num_samples_ = basis_->size();
   dim_ = type.dim;
   num_vertices_ = family_num_vertices(type.family);
+  product_ = std::make_unique<const JacobianProduct>(type, *basis_);
+  if (type.order > sampled_max_order(type.family)) return;
   const auto shapes = factor_shapes(type.family);
   const auto s = static_cast<std::size_t>(num_samples_);
   const auto n = static_cast<std::size_t>(num_nodes_);
@@ -383,6 +398,7 @@ void JacobianSpace::build_exact() const {
 }
 
 const std::vector<mpq_class>& JacobianSpace::exact_gradient(int c) const {
+  QV_ASSERT(has_sample_gradients(), "no sample gradients for " << type_->name);
   build_exact();
   return exact_[c];
 }

@@ -8,8 +8,11 @@
 // the gradient (exact in binary). Sample k is at BezierBasis::point(k) (Bézier domain).
 #include <gmpxx.h>
 
+#include <memory>
 #include <mutex>
 #include <vector>
+
+#include "analysis/jacobian_product.hpp"
 
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
@@ -44,7 +47,17 @@ class JacobianSpace {
   double straight_rel_error() const noexcept { return straight_rel_error_; }
 
   /// The exact gradient matrices (same layout), built on first use; thread-safe.
+  /// @pre has_sample_gradients()
   const std::vector<mpq_class>& exact_gradient(int c) const;
+
+  /// The Bernstein-product path to J's coefficients (jacobian_product.hpp); nullptr for
+  /// pyramids, which are sampled (Paper IV).
+  const JacobianProduct* product() const noexcept { return product_.get(); }
+  /// Whether the sampling matrices above exist: pyramids, and the orders the sampled path
+  /// served before the product path (sampled_max_order), which `check` still samples.
+  /// Beyond them (e.g. hexahedra of order 4-6, 1331-4913 samples) only the product path is
+  /// built; jacobian_samples then evaluates the product coefficients at the points.
+  bool has_sample_gradients() const noexcept { return !grad_[0].empty(); }
 
  private:
   void build_exact() const;
@@ -62,6 +75,7 @@ class JacobianSpace {
   double gradient_rel_error_ = 0;
   double straight_row_sum_ = 0;
   double straight_rel_error_ = 0;
+  std::unique_ptr<const JacobianProduct> product_;
   mutable std::once_flag exact_once_;
   mutable std::vector<mpq_class> exact_[3];
 };
@@ -69,6 +83,11 @@ class JacobianSpace {
 /// The shared space of `type`; thread-safe, built once.
 /// @pre jacobian_supported(type)
 const JacobianSpace& jacobian_space(const ElementType& type);
+
+/// Highest order with sample gradient matrices per family: lines 10, triangles and
+/// quadrangles 6, tetrahedra 4, prisms and hexahedra 3 (the orders whose equispaced
+/// Lagrange-to-Bézier conversion of the J space is well enough conditioned in double).
+int sampled_max_order(ElementFamily family) noexcept;
 
 /// True when quadval computes Jacobian bounds for this type (all Lagrange types of the
 /// six families, up to max_supported_order; not pyramids).

@@ -1,12 +1,35 @@
-// The Jacobian space of pyramids: exact shape-function gradients at the samples of the
-// enriched Bézier basis (Paper IV eq. 6), rounded for the batched double path.
+// The Jacobian space of pyramids by Bernstein products (Paper IV eqs. 2-3 and 6, with the
+// products of Paper V Prop. 4): exact derivative maps from the nodes to the control points
+// of X_xi, X_eta, X_zeta in cube coordinates, then JacobianProduct's convolutions.
+//
+// In cube coordinates (u, v, t) (bezier/pyramid_basis.hpp; X = 2u - 1, Y = 2v - 1), the
+// functions of Bergot's space are phi = X^a Y^b t^k (a, b <= k <= r), and their
+// derivatives in Gmsh's coordinates (xi = X t, eta = Y t, zeta = 1 - t) are polynomials:
+//   dphi/dxi   = a X^(a-1) Y^b t^(k-1)          degrees (r-1, r,   r-1) in (u, v, t)
+//   dphi/deta  = b X^a Y^(b-1) t^(k-1)          degrees (r,   r-1, r-1)
+//   dphi/dzeta = (a + b - k) X^a Y^b t^(k-1)    degrees (r,   r,   r-1)
+// so J = X_xi . (X_eta x X_zeta) has degrees (3r-1, 3r-1, 3r-3): the enriched basis (eq. 6).
+// Their face t = 0 holds the limits of the derivatives along rays into the apex, never a
+// value at the apex itself. Nothing here goes through the equispaced Lagrange-to-Bézier
+// matrix of the J space (factor degree up to 26), whose norm grows like 2^n.
+//
+// The monomial coefficients of the shape functions are exact rationals (inverse of the
+// generalized Vandermonde matrix). For complete types the matrix is written in the basis
+//   X^a Y^b tau_m(t),  a, b <= m,  tau_m(t) = t^m prod_{l = m+1..r} (t - l / r),
+// which spans the same space and is block triangular over the node layers t = l / r
+// (tau_m vanishes on the layers above m): Gauss-Jordan stays sparse, ~10x faster at r = 9.
+#include <gmpxx.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <numeric>
+
 #include "analysis/pyramid_space.hpp"
 
-#include <cmath>
-#include <limits>
-#include <mutex>
-
 #include "analysis/exact_inverse.hpp"
+#include "analysis/jacobian_product.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
@@ -15,7 +38,7 @@
 namespace quadval {
 namespace {
 
-constexpr double kUnit = std::numeric_limits<double>::epsilon() / 2;
+using Exponents = std::array<int, 3>;
 
 mpq_class power(const mpq_class& x, int e) {
   mpq_class r = 1;
@@ -23,7 +46,14 @@ mpq_class power(const mpq_class& x, int e) {
   return r;
 }
 
-// x snapped to the lattice m / p (exact Gmsh node coordinates are multiples of 1/p).
+mpz_class binomial(int n, int k) {
+  if (k < 0 || k > n) return 0;
+  mpz_class r;
+  mpz_bin_uiui(r.get_mpz_t(), static_cast<unsigned long>(n), static_cast<unsigned long>(k));
+  return r;
+}
+
+// x snapped to the lattice m / p (Gmsh's pyramid nodes are multiples of 1/p).
 mpq_class snap(double x, int p, const ElementType& type) {
   const double m = std::round(x * p);
   QV_ASSERT(std::abs(x * p - m) < 1e-9, "node coordinate " << x << " of " << type.name << " off the 1/" << p << " lattice");
@@ -32,140 +62,274 @@ mpq_class snap(double x, int p, const ElementType& type) {
   return q;
 }
 
-// The double nearest to q (within one ulp: get_d truncates, the correction rounds).
+// The double nearest to q, and the smallest double >= q.
 double nearest(const mpq_class& q) {
   const double d = q.get_d();
-  return d + mpq_class(q - mpq_class(d)).get_d();
+  double best = d;
+  mpq_class err = abs(mpq_class(d) - q);
+  for (double c : {std::nextafter(d, INFINITY), std::nextafter(d, -INFINITY)}) {
+    const mpq_class e = abs(mpq_class(c) - q);
+    if (e < err) err = e, best = c;
+  }
+  return best;
+}
+double round_up(const mpq_class& q) {
+  double d = q.get_d();
+  while (mpq_class(d) < q) d = std::nextafter(d, INFINITY);
+  return d;
 }
 
-// Distinct coordinates m / degree (m = 0..degree) of a line factor; {1} for a missing one.
-std::vector<mpq_class> factor_coordinates(const BezierBasis& basis, std::size_t f) {
-  if (f >= basis.factors().size()) return {mpq_class(1)};
-  const BernsteinSimplex& fac = *basis.factors()[f];
-  std::vector<mpq_class> c(static_cast<std::size_t>(fac.size()));
-  for (int i = 0; i < fac.size(); ++i) {
-    mpq_class q(fac.point_numerators(i)[1], fac.point_denominator());
-    q.canonicalize();
-    c[static_cast<std::size_t>(i)] = q;
+// tau_m(t) = t^m prod_{l = m+1..r} (t - l / r), as coefficients of t^0..t^r.
+std::vector<mpq_class> tau(int m, int r) {
+  std::vector<mpq_class> c(static_cast<std::size_t>(r + 1), mpq_class(0));
+  c[static_cast<std::size_t>(m)] = 1;
+  for (int l = m + 1; l <= r; ++l) {
+    mpq_class root(l, r);
+    root.canonicalize();
+    for (int k = r; k >= 0; --k) {  // c <- c * (t - root)
+      const auto ks = static_cast<std::size_t>(k);
+      c[ks] = (k > 0 ? c[ks - 1] : mpq_class(0)) - root * c[ks];
+    }
   }
   return c;
 }
 
 }  // namespace
 
-void exact_pyramid_gradients(const ElementType& type, const BezierBasis& basis,
-                             std::vector<mpq_class> (&out)[3]) {
+PyramidShapeCoefficients pyramid_shape_coefficients(const ElementType& type) {
   QV_ASSERT(type.family == ElementFamily::pyramid && type.has_lagrange_basis, type.name << " is no Lagrange pyramid");
-  const detail::PolynomialSpace space = detail::polynomial_space(type, detail::FactorBasis::monomial);
-  const auto& ex = space.exponents;  // (a, b, k): X^a Y^b t^k
+  PyramidShapeCoefficients out;
+  out.exponents = detail::polynomial_space(type, detail::FactorBasis::monomial).exponents;
+  const auto& ex = out.exponents;
   const auto ref = reference_nodes(type);
   const std::size_t n = ref.size();
   QV_ASSERT(ex.size() == n, "pyramid space " << ex.size() << " vs " << n << " nodes");
   const int p = type.order;
-
-  // Generalized Vandermonde V(i, j) = phi_j(node i); at the apex only phi = 1 (k = 0) is
-  // non-zero (|X^a Y^b t^k| <= t^k).
-  std::vector<mpq_class> v(n * n);
+  // Node coordinates (X, Y, t); X, Y unused at the apex (t = 0).
+  std::vector<std::array<mpq_class, 3>> node(n);
   for (std::size_t i = 0; i < n; ++i) {
     const mpq_class t = 1 - snap(ref[i][2], p, type);
-    for (std::size_t j = 0; j < n; ++j) {
-      if (sgn(t) == 0) {
-        v[i * n + j] = ex[j][2] == 0 ? 1 : 0;
-        continue;
-      }
-      const mpq_class x = snap(ref[i][0], p, type) / t, y = snap(ref[i][1], p, type) / t;
-      v[i * n + j] = power(x, ex[j][0]) * power(y, ex[j][1]) * power(t, ex[j][2]);
+    node[i][2] = t;
+    if (sgn(t) != 0) node[i][0] = snap(ref[i][0], p, type) / t, node[i][1] = snap(ref[i][1], p, type) / t;
+  }
+  // Rows: nodes from the base layer up; columns: basis functions by decreasing m (k).
+  std::vector<std::size_t> rows(n), cols(n);
+  std::iota(rows.begin(), rows.end(), 0);
+  std::iota(cols.begin(), cols.end(), 0);
+  std::stable_sort(rows.begin(), rows.end(), [&](std::size_t a, std::size_t b) { return node[a][2] > node[b][2]; });
+  std::stable_sort(cols.begin(), cols.end(), [&](std::size_t a, std::size_t b) { return ex[a][2] > ex[b][2]; });
+  std::vector<std::vector<mpq_class>> taus;
+  if (type.complete)
+    for (int m = 0; m <= p; ++m) taus.push_back(tau(m, p));
+  // phi_j(node i): X^a Y^b times t^k (monomials) or tau_k(t) (complete types).
+  const auto basis_value = [&](std::size_t i, std::size_t j) {
+    const mpq_class& t = node[i][2];
+    mpq_class tpart = 0;
+    if (type.complete) {
+      const auto& c = taus[static_cast<std::size_t>(ex[j][2])];
+      for (std::size_t k = c.size(); k-- > 0;) tpart = tpart * t + c[k];
+    } else {
+      tpart = power(t, ex[j][2]);
+    }
+    if (sgn(t) == 0) return ex[j][0] == 0 && ex[j][1] == 0 ? tpart : mpq_class(0);  // |X^a Y^b| t^k -> 0
+    return mpq_class(power(node[i][0], ex[j][0]) * power(node[i][1], ex[j][1]) * tpart);
+  };
+  std::vector<mpq_class> v(n * n);
+  for (std::size_t r = 0; r < n; ++r)
+    for (std::size_t c = 0; c < n; ++c) v[r * n + c] = basis_value(rows[r], cols[c]);
+  const std::vector<mpq_class> inv = exact_inverse(std::move(v), n, type);  // (col c, row r)
+  // coef[j * n + i]: N_i = sum_j phi_j coef[j][i], back in the original orders.
+  std::vector<mpq_class> coef(n * n);
+  for (std::size_t c = 0; c < n; ++c)
+    for (std::size_t r = 0; r < n; ++r) coef[cols[c] * n + rows[r]] = inv[c * n + r];
+  if (!type.complete) {
+    out.coefficients = std::move(coef);
+    return out;
+  }
+  // X^a Y^b tau_m(t) = sum_k tau_m[k] X^a Y^b t^k, with k >= m >= max(a, b): in the space.
+  std::map<Exponents, std::size_t> index;
+  for (std::size_t j = 0; j < n; ++j) index[ex[j]] = j;
+  out.coefficients.assign(n * n, mpq_class(0));
+  for (std::size_t j = 0; j < n; ++j) {
+    const auto& c = taus[static_cast<std::size_t>(ex[j][2])];
+    for (int k = ex[j][2]; k <= p; ++k) {
+      const mpq_class& w = c[static_cast<std::size_t>(k)];
+      if (sgn(w) == 0) continue;
+      const std::size_t jk = index.at({ex[j][0], ex[j][1], k});
+      for (std::size_t i = 0; i < n; ++i)
+        if (sgn(coef[j * n + i]) != 0) out.coefficients[jk * n + i] += w * coef[j * n + i];
     }
   }
-  const std::vector<mpq_class> coef = exact_inverse(std::move(v), n, type);  // N_i = sum_j phi_j C(j, i)
+  return out;
+}
 
-  const auto us = factor_coordinates(basis, 0), vs = factor_coordinates(basis, 1),
-             ts = factor_coordinates(basis, 2);
-  const std::size_t nu = us.size(), nv = vs.size(), nt = ts.size();
-  const auto s = static_cast<std::size_t>(basis.size());
-  QV_ASSERT(s == nu * nv * nt, "pyramid basis layout");
-  const auto q1 = static_cast<std::size_t>(p + 1);
-  // Powers X^e, Y^e of the sample coordinates, e = 0..p.
-  std::vector<mpq_class> xp(nu * q1), yp(nv * q1);
-  for (std::size_t a = 0; a < nu; ++a)
-    for (std::size_t e = 0; e < q1; ++e) xp[a * q1 + e] = power(2 * us[a] - 1, static_cast<int>(e));
-  for (std::size_t b = 0; b < nv; ++b)
-    for (std::size_t e = 0; e < q1; ++e) yp[b * q1 + e] = power(2 * vs[b] - 1, static_cast<int>(e));
-  for (auto& o : out) o.assign(s * n, mpq_class(0));
+std::array<int, 3> pyramid_derivative_degrees(int r, int c) noexcept {
+  switch (c) {
+    case 0: return {r - 1, r, r - 1};
+    case 1: return {r, r - 1, r - 1};
+    default: return {r, r, r - 1};
+  }
+}
 
-  // Sum factorisation per node i and t value: A_c(x-exp, y-exp) collects the t part, then
-  // B_c(x-exp) the Y part at each v, then the X part at each u.
-  std::vector<mpq_class> acc[3], bcc[3];
-  for (auto& a : acc) a.resize(q1 * q1);
-  for (auto& b : bcc) b.resize(q1);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (std::size_t c = 0; c < nt; ++c) {
-      for (auto& a : acc)
-        for (auto& z : a) z = 0;
-      for (std::size_t j = 0; j < n; ++j) {
-        const int a = ex[j][0], b = ex[j][1], k = ex[j][2];
-        if (k == 0 || sgn(coef[j * n + i]) == 0) continue;
-        const mpq_class w = coef[j * n + i] * power(ts[c], k - 1);
-        // d/dxi: a X^(a-1) Y^b; d/deta: b X^a Y^(b-1); d/dzeta: (a+b-k) X^a Y^b.
-        if (a > 0) acc[0][static_cast<std::size_t>(a - 1) * q1 + static_cast<std::size_t>(b)] += a * w;
-        if (b > 0) acc[1][static_cast<std::size_t>(a) * q1 + static_cast<std::size_t>(b - 1)] += b * w;
-        if (a + b != k) acc[2][static_cast<std::size_t>(a) * q1 + static_cast<std::size_t>(b)] += (a + b - k) * w;
-      }
-      for (std::size_t qv = 0; qv < nv; ++qv) {
-        for (int d = 0; d < 3; ++d)
-          for (std::size_t ea = 0; ea < q1; ++ea) {
-            mpq_class sum = 0;
-            for (std::size_t eb = 0; eb < q1; ++eb)
-              if (sgn(acc[d][ea * q1 + eb]) != 0) sum += acc[d][ea * q1 + eb] * yp[qv * q1 + eb];
-            bcc[d][ea] = sum;
-          }
-        for (std::size_t pu = 0; pu < nu; ++pu) {
-          const std::size_t k = pu + nu * (qv + nv * c);
-          for (int d = 0; d < 3; ++d) {
-            mpq_class sum = 0;
-            for (std::size_t ea = 0; ea < q1; ++ea)
-              if (sgn(bcc[d][ea]) != 0) sum += bcc[d][ea] * xp[pu * q1 + ea];
-            out[d][k * n + i] = sum;
+std::vector<mpq_class> pyramid_scaled_derivative(int r, int c, const std::vector<Exponents>& exponents,
+                                                 const std::vector<mpq_class>& monomial) {
+  const std::array<int, 3> deg = pyramid_derivative_degrees(r, c);
+  std::array<std::size_t, 3> size{};
+  for (std::size_t h = 0; h < 3; ++h) size[h] = static_cast<std::size_t>(deg[h] + 1);
+  // Integer numerators over the common denominator of the inputs.
+  mpz_class den = 1;
+  for (const mpq_class& q : monomial) mpz_lcm(den.get_mpz_t(), den.get_mpz_t(), q.get_den_mpz_t());
+  // The derivative in the monomial basis X^e0 Y^e1 t^e2 (degrees deg).
+  std::vector<mpz_class> in(size[0] * size[1] * size[2], mpz_class(0));
+  for (std::size_t j = 0; j < exponents.size(); ++j) {
+    if (sgn(monomial[j]) == 0) continue;
+    const int a = exponents[j][0], b = exponents[j][1], k = exponents[j][2];
+    if (k == 0) continue;  // constant
+    int factor = 0, ea = a, eb = b;
+    if (c == 0) factor = a, ea = a - 1;
+    if (c == 1) factor = b, eb = b - 1;
+    if (c == 2) factor = a + b - k;
+    if (factor == 0) continue;
+    QV_ASSERT(ea <= deg[0] && eb <= deg[1] && k - 1 <= deg[2], "pyramid exponent beyond order " << r);
+    const mpz_class num = monomial[j].get_num() * (den / monomial[j].get_den());
+    in[static_cast<std::size_t>(ea) + size[0] * (static_cast<std::size_t>(eb) + size[1] * static_cast<std::size_t>(k - 1))] += factor * num;
+  }
+  // Axis by axis: monomial -> scaled Bernstein (C(n, i) times the Bernstein coefficient),
+  // integer matrices: t^l -> C(n-l, i-l); X^e = (2u-1)^e -> sum_l C(e,l) 2^l (-1)^(e-l) C(n-l, i-l).
+  for (std::size_t h = 0; h < 3; ++h) {
+    const int n = deg[h];
+    const auto s = size[h];
+    std::vector<mpz_class> m(s * s, mpz_class(0));  // m[i * s + e]
+    for (int i = 0; i <= n; ++i)
+      for (int e = 0; e <= n; ++e) {
+        mpz_class sum = 0;
+        if (h == 2) {
+          sum = binomial(n - e, i - e);
+        } else {
+          for (int l = 0; l <= e; ++l) {
+            const mpz_class term = binomial(e, l) * (mpz_class(1) << l) * binomial(n - l, i - l);
+            if ((e - l) % 2 == 0) sum += term; else sum -= term;
           }
         }
+        m[static_cast<std::size_t>(i) * s + static_cast<std::size_t>(e)] = sum;
       }
+    std::size_t inner = 1, outer = 1;
+    for (std::size_t g = 0; g < h; ++g) inner *= size[g];
+    for (std::size_t g = h + 1; g < 3; ++g) outer *= size[g];
+    std::vector<mpz_class> out(in.size(), mpz_class(0));
+    for (std::size_t o = 0; o < outer; ++o)
+      for (std::size_t e = 0; e < s; ++e)
+        for (std::size_t q = 0; q < inner; ++q) {
+          const mpz_class& x = in[(o * s + e) * inner + q];
+          if (sgn(x) == 0) continue;
+          for (std::size_t i = 0; i < s; ++i)
+            if (sgn(m[i * s + e]) != 0) out[(o * s + i) * inner + q] += m[i * s + e] * x;
+        }
+    in.swap(out);
+  }
+  std::vector<mpq_class> result(in.size());
+  for (std::size_t q = 0; q < in.size(); ++q) {
+    result[q] = mpq_class(in[q], den);
+    result[q].canonicalize();
+  }
+  return result;
+}
+
+void JacobianProduct::init_pyramid() {
+  const int r = order_;
+  const ElementType& type = *type_;
+  num_factors_ = r == 1 ? 2 : 3;  // r = 1: J does not depend on t (Paper IV §4.1)
+  for (std::size_t h = 0; h < 3; ++h) {
+    factor_dim_[h] = 1;
+    factor_first_[h] = static_cast<int>(h);
+    factor_interval_[h] = true;
+  }
+  const auto space_of = [&](std::array<int, 3> degree) {
+    Space s;
+    s.degree = degree;
+    s.total = 1;
+    for (std::size_t h = 0; h < 3; ++h) {
+      s.size[h] = degree[h] + 1;
+      s.total *= s.size[h];
     }
+    return s;
+  };
+  const auto mult_of = [](const Space& s, int k) {
+    mpz_class w = 1;
+    for (std::size_t h = 0; h < 3; ++h) {
+      w *= binomial(s.degree[h], k % s.size[h]);
+      k /= s.size[h];
+    }
+    return w;
+  };
+  std::array<int, 3> jdeg{0, 0, 0};
+  for (int c = 0; c < 3; ++c) {
+    const auto cs = static_cast<std::size_t>(c);
+    deriv_space_[cs] = space_of(pyramid_derivative_degrees(r, c));
+    for (std::size_t h = 0; h < 3; ++h) jdeg[h] += deriv_space_[cs].degree[h];
+    auto& inv = deriv_inv_mult_[cs];
+    inv.resize(static_cast<std::size_t>(deriv_space_[cs].total));
+    for (int k = 0; k < deriv_space_[cs].total; ++k)
+      inv[static_cast<std::size_t>(k)] = nearest(mpq_class(1) / mpq_class(mult_of(deriv_space_[cs], k)));
+  }
+  const Space jspace = space_of(jdeg);
+  QV_ASSERT(jspace.total == basis_->size() && static_cast<int>(basis_->factors().size()) == num_factors_,
+            "J space of " << type.name << " differs from its basis");
+  for (int h = 0; h < num_factors_; ++h)
+    QV_ASSERT(basis_->factors()[static_cast<std::size_t>(h)]->degree() == jdeg[static_cast<std::size_t>(h)], "pyramid basis degree");
+  mult_.resize(static_cast<std::size_t>(jspace.total));
+  inv_mult_.resize(mult_.size());
+  for (int k = 0; k < jspace.total; ++k) {
+    mult_[static_cast<std::size_t>(k)] = mult_of(jspace, k);
+    inv_mult_[static_cast<std::size_t>(k)] = nearest(mpq_class(1) / mpq_class(mult_[static_cast<std::size_t>(k)]));
+  }
+  std::array<int, 3> bc{0, 0, 0};
+  for (std::size_t h = 0; h < 3; ++h) bc[h] = deriv_space_[1].degree[h] + deriv_space_[2].degree[h];
+  const Space bcs = space_of(bc);
+  cross_size_ = bcs.total;
+  cross_ = make_product(deriv_space_[1], deriv_space_[2], bcs);
+  dot_ = make_product(deriv_space_[0], bcs, jspace);
+  rounding_ = rounding_gamma(3 * dot_.max_terms + 2 * cross_.max_terms) + 2.01 * 0x1p-53;
+
+  // Curved map: the type's own shape functions; straight: the 5-node pyramid's, in the
+  // same derivative spaces (lower degrees written in the higher-degree Bernstein bases).
+  for (SampleMap which : {SampleMap::curved, SampleMap::straight}) {
+    Map& map = maps_[static_cast<std::size_t>(which)];
+    const ElementType& shape = which == SampleMap::curved ? type : *find_element_type(ElementFamily::pyramid, 1, true);
+    PyramidShapeCoefficients sc = pyramid_shape_coefficients(shape);
+    const auto n = static_cast<std::size_t>(shape.num_nodes);
+    map.num_nodes = shape.num_nodes;
+    for (int c = 0; c < 3; ++c) {
+      const auto cs = static_cast<std::size_t>(c);
+      const auto rows = static_cast<std::size_t>(deriv_space_[cs].total);
+      auto& g = map.matrix[cs];
+      g.assign(rows * n, 0.0);
+      std::vector<mpq_class> row_abs(rows, mpq_class(0)), column(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t j = 0; j < n; ++j) column[j] = sc.coefficients[j * n + i];
+        const std::vector<mpq_class> d = pyramid_scaled_derivative(r, c, sc.exponents, column);
+        for (std::size_t k = 0; k < rows; ++k) {
+          g[k * n + i] = nearest(d[k]);
+          row_abs[k] += abs(d[k]);
+        }
+      }
+      mpq_class worst = 0;
+      for (std::size_t k = 0; k < rows; ++k)
+        worst = std::max(worst, mpq_class(row_abs[k] * mpq_class(deriv_inv_mult_[cs][k]) * (1 + mpq_class(1, 1 << 20))));
+      map.row_sum[cs] = round_up(worst);
+    }
+    map.pyramid = std::make_shared<const PyramidShapeCoefficients>(std::move(sc));
   }
 }
 
 void JacobianSpace::init_pyramid() {
-  const ElementType& type = *type_;
-  num_nodes_ = type.num_nodes;
+  // Paper IV through Bernstein products only: no sampling matrices (has_sample_gradients()
+  // is false), so bounds_from_samples takes the product path from the nodes.
+  num_nodes_ = type_->num_nodes;
   num_samples_ = basis_->size();
   dim_ = 3;
   num_vertices_ = 5;
-  const auto s = static_cast<std::size_t>(num_samples_);
-  std::call_once(exact_once_, [&] { exact_pyramid_gradients(type, *basis_, exact_); });
-
-  // Rounded matrices and the constants of jacobian_space.hpp: entries within 2u of the
-  // exact ones; row sums enlarged to cover the exact entries and their summation.
-  const auto round_rows = [&](const std::vector<mpq_class> (&exact)[3], std::vector<double> (&g)[3],
-                              std::size_t n, double& row_sum) {
-    double r = 0;
-    for (int c = 0; c < 3; ++c) {
-      g[c].resize(exact[c].size());
-      for (std::size_t i = 0; i < exact[c].size(); ++i) g[c][i] = nearest(exact[c][i]);
-      for (std::size_t k = 0; k < s; ++k) {
-        double row = 0;
-        for (std::size_t i = 0; i < n; ++i) row += std::abs(g[c][k * n + i]);
-        r = std::max(r, row);
-      }
-    }
-    row_sum = r * (1 + 8 * kUnit + rounding_gamma(static_cast<int>(n)));
-  };
-  gradient_rel_error_ = 2 * kUnit;
-  round_rows(exact_, grad_, static_cast<std::size_t>(num_nodes_), gradient_row_sum_);
-
-  const ElementType* linear = find_element_type(ElementFamily::pyramid, 1, true);
-  std::vector<mpq_class> straight_exact[3];
-  exact_pyramid_gradients(*linear, *basis_, straight_exact);
-  straight_rel_error_ = 2 * kUnit;
-  round_rows(straight_exact, straight_, 5, straight_row_sum_);
+  product_ = std::make_unique<const JacobianProduct>(*type_, *basis_);
 }
 
 }  // namespace quadval

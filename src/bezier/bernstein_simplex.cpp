@@ -83,6 +83,28 @@ std::vector<mpq_class> invert(std::vector<mpq_class> a, int n) {
   return inv;
 }
 
+// V[k][alpha] = B_alpha(point k), points beta / den (eq. 18).
+template <class PointOf>
+std::vector<mpq_class> collocation(int dim, const std::vector<MultiIndex>& alphas, PointOf point_of,
+                                   int den) {
+  const auto n = alphas.size();
+  std::vector<mpq_class> v(n * n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const MultiIndex beta = point_of(static_cast<int>(k));
+    for (std::size_t i = 0; i < n; ++i) {
+      const MultiIndex& alpha = alphas[i];
+      mpq_class b(multinomial(dim, alpha));
+      for (int a = 0; a <= dim; ++a) {
+        mpq_class l(beta[static_cast<std::size_t>(a)], den);
+        l.canonicalize();  // gmpxx does not reduce a num/den pair
+        for (int e = 0; e < alpha[static_cast<std::size_t>(a)]; ++e) b *= l;
+      }
+      v[k * n + i] = b;
+    }
+  }
+  return v;
+}
+
 // Rounds up: the smallest double >= q.
 double round_up(const mpq_class& q) {
   double d = q.get_d();  // truncates toward zero
@@ -162,35 +184,15 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
       if (alphas_[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] == degree)
         vertex_[static_cast<std::size_t>(i)] = true;
 
-  // Collocation matrix V[k][alpha] = B_alpha(point k) (eq. 18); points beta / n.
-  std::vector<mpq_class> v(n_sz * n_sz);
-  const int den = point_denominator();
-  for (int k = 0; k < s; ++k) {
-    const MultiIndex beta = point_numerators(k);
-    for (int i = 0; i < s; ++i) {
-      const MultiIndex& alpha = alphas_[static_cast<std::size_t>(i)];
-      mpq_class b(multinomial(dim, alpha));
-      for (int a = 0; a <= dim; ++a) {
-        mpq_class l(beta[static_cast<std::size_t>(a)], den);
-        l.canonicalize();  // gmpxx does not reduce a num/den pair
-        for (int e = 0; e < alpha[static_cast<std::size_t>(a)]; ++e) b *= l;
-      }
-      v[static_cast<std::size_t>(k) * n_sz + static_cast<std::size_t>(i)] = b;
-    }
+  // Collocation matrix V[k][alpha] = B_alpha(point k) (eq. 18), rounded; T = V^-1 is
+  // built on first use (build_to_bezier).
+  {
+    const std::vector<mpq_class> v = collocation(dim, alphas_, [this](int k) { return point_numerators(k); },
+                                                 point_denominator());
+    to_lagrange_.resize(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) to_lagrange_[i] = nearest(v[i]);
+    to_lagrange_t_ = transpose_blocks(to_lagrange_, n_sz);
   }
-  exact_->to_bezier = invert(std::move(v), s);
-  to_bezier_.resize(n_sz * n_sz);
-  mpq_class worst_row = 0;
-  for (std::size_t r = 0; r < n_sz; ++r) {
-    mpq_class row = 0;
-    for (std::size_t c = 0; c < n_sz; ++c) {
-      const mpq_class& q = exact_->to_bezier[r * n_sz + c];
-      to_bezier_[r * n_sz + c] = nearest(q);
-      row += abs(q);
-    }
-    if (row > worst_row) worst_row = row;
-  }
-  to_bezier_norm_ = round_up(worst_row);
 
   // Subdivision (eq. 20) by blossoming: the child's coefficient beta is the blossom of the
   // parent at (w_0 repeated beta_0 times, ..., w_d repeated beta_d times), i.e. the
@@ -246,8 +248,50 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
       }
     }
   }
-  to_bezier_t_ = transpose_blocks(to_bezier_, n_sz);
   subdivision_t_ = transpose_blocks(subdivision_, n_sz);
+}
+
+void BernsteinSimplex::build_to_bezier() const {
+  std::call_once(to_bezier_once_, [this] {
+    const int s = size();
+    const auto n_sz = static_cast<std::size_t>(s);
+    exact_->to_bezier = invert(collocation(dim_, alphas_, [this](int k) { return point_numerators(k); },
+                                           point_denominator()),
+                               s);
+    to_bezier_.resize(n_sz * n_sz);
+    mpq_class worst_row = 0;
+    for (std::size_t r = 0; r < n_sz; ++r) {
+      mpq_class row = 0;
+      for (std::size_t c = 0; c < n_sz; ++c) {
+        const mpq_class& q = exact_->to_bezier[r * n_sz + c];
+        to_bezier_[r * n_sz + c] = nearest(q);
+        row += abs(q);
+      }
+      if (row > worst_row) worst_row = row;
+    }
+    to_bezier_norm_ = round_up(worst_row);
+    to_bezier_t_ = transpose_blocks(to_bezier_, n_sz);
+  });
+}
+
+std::span<const double> BernsteinSimplex::lagrange_to_bezier() const {
+  build_to_bezier();
+  return to_bezier_;
+}
+
+std::span<const double> BernsteinSimplex::lagrange_to_bezier_transposed() const {
+  build_to_bezier();
+  return to_bezier_t_;
+}
+
+double BernsteinSimplex::lagrange_to_bezier_norm() const {
+  build_to_bezier();
+  return to_bezier_norm_;
+}
+
+const BernsteinSimplex::Exact& BernsteinSimplex::exact() const {
+  build_to_bezier();
+  return *exact_;
 }
 
 BernsteinSimplex::~BernsteinSimplex() = default;

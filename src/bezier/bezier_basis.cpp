@@ -33,17 +33,23 @@ std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int p) {
 }
 
 int max_supported_order(ElementFamily family) noexcept {
-  // Limited by conditioning, not memory: the equispaced Lagrange-to-Bézier conversion of
-  // the tensor families has norm Lambda_1D(n)^d (~8e3 per direction at degree 11), which
-  // multiplies the rounding bound of the samples. Beyond these orders the certified
-  // margin would exceed ~1e-3 of |J|.
+  // The coefficients are Bernstein products of the geometry's control points
+  // (src/analysis/jacobian_product.cpp), so the J space's conversion no longer limits us.
+  // What does: (1) the a priori rounding bound of the geometry's equispaced Lagrange-to-
+  // Bézier conversion, whose row sums grow like the per-direction norms (1D: 15 at degree
+  // 4, 89 at 6, ~1e3 at 9): random curved triangles of order 10 and quadrangles of order 9
+  // were all left undetermined in tests/analysis/jacobian_bounds_test.cpp; (2) memory: a
+  // tetrahedron of order 5 has a degree-12 factor of 455 coefficients, whose 8
+  // subdivision matrices hold 1.7 million entries (and as many exact rationals); (3) time:
+  // prisms and hexahedra of orders 5-6 build and bound correctly, but one subdivision of
+  // a 17^3-coefficient hexahedron costs ~2 Mflop, too slow for the dense-sampling tests.
   switch (family) {
     case ElementFamily::line: return 10;
-    case ElementFamily::triangle:
-    case ElementFamily::quadrangle: return 6;
+    case ElementFamily::triangle: return 9;
+    case ElementFamily::quadrangle: return 8;
     case ElementFamily::tetrahedron: return 4;
     case ElementFamily::prism:
-    case ElementFamily::hexahedron: return 3;
+    case ElementFamily::hexahedron: return 4;
     case ElementFamily::pyramid: return kPyramidMaxOrder;
     default: return 0;
   }
@@ -60,9 +66,6 @@ BezierBasis::BezierBasis(ElementFamily family, int order,
     dim_ += f->dim();
     size_ *= f->size();
     num_children_ *= f->num_children();
-    // The product of norms, each step rounded up.
-    to_bezier_norm_ = std::nextafter(to_bezier_norm_ * f->lagrange_to_bezier_norm(),
-                                     std::numeric_limits<double>::infinity());
     // One pass: entries rounded to nearest (u) and an s-term dot product (gamma_s).
     rounding += u + rounding_gamma(f->size());
     subdivision += rounding_gamma(f->size());
@@ -70,6 +73,9 @@ BezierBasis::BezierBasis(ElementFamily family, int order,
   // Cross terms between passes are second order: 1% covers them many times over.
   to_bezier_rounding_ = rounding * 1.01;
   subdivision_rounding_ = subdivision * 1.01;
+  // V: nonnegative entries rounded to nearest (relative u), exact rows summing to 1, so a
+  // pass keeps max|values| <= (1 + u)(1 + gamma_s) max|input| and adds u + gamma_s of it.
+  from_bezier_rounding_ = rounding * 1.01;
   for (int i = 0; i < size_; ++i) {
     bool vertex = true;
     for (std::size_t f = 0; f < factors_.size(); ++f)
@@ -162,6 +168,24 @@ void BezierBasis::apply_factors(const double* in, double* out, double* scratch,
     src = dst;
     stride *= s;
   }
+}
+
+double BezierBasis::to_bezier_norm() const {
+  std::call_once(norm_once_, [this] {
+    double norm = 1;
+    for (const BernsteinSimplex* f : factors_)  // the product of norms, each step rounded up
+      norm = std::nextafter(norm * f->lagrange_to_bezier_norm(), std::numeric_limits<double>::infinity());
+    to_bezier_norm_ = norm;
+  });
+  return to_bezier_norm_;
+}
+
+void BezierBasis::from_bezier_batch(const double* coeffs, std::size_t count, double* samples,
+                                    double* scratch) const {
+  apply_factors(coeffs, samples, scratch, count, [this](std::size_t f) {
+    return std::pair{factors_[f]->bezier_to_lagrange().data(),
+                     factors_[f]->bezier_to_lagrange_transposed().data()};
+  });
 }
 
 void BezierBasis::to_bezier(const double* samples, double* coeffs, double* scratch) const {

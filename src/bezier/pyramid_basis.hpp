@@ -16,7 +16,8 @@
 // J; by degree elevation each enriched coefficient is a convex combination of generalized
 // ones, so the enriched coefficients bound J at least as sharply. quadval therefore
 // computes the enriched coefficients directly (pyramid_generalized_size documents the
-// smaller dimension of eq. 4 for comparison).
+// smaller dimension of eq. 4 for comparison), as Bernstein products of the derivatives
+// (src/analysis/pyramid_space.cpp).
 #include <array>
 #include <vector>
 
@@ -24,9 +25,11 @@
 
 namespace quadval {
 
-/// Highest pyramid order with a Jacobian basis: factors of degree 3r-1 <= 11, the same
-/// conditioning limit as the quadrangles of order 6 (bezier_basis.cpp).
-inline constexpr int kPyramidMaxOrder = 4;
+/// Highest pyramid order with a Jacobian basis: every order Gmsh defines (ids 118-131).
+/// The coefficients come from Bernstein products of the derivatives' control points
+/// (src/analysis/pyramid_space.cpp), never from the equispaced Lagrange-to-Bézier matrix
+/// of the J space, whose conditioning (factor degree 3r-1 up to 26) would limit r to 4.
+inline constexpr int kPyramidMaxOrder = 9;
 
 /// Line factors of the enriched basis (eq. 6) of the order-r pyramid: (3r-1, 3r-1, 3r-3)
 /// for r >= 2, (2, 2) for r = 1. @pre r >= 1

@@ -1,5 +1,6 @@
 list(APPEND QUADVAL_SOURCES
   src/bezier/bernstein_simplex.cpp
   src/bezier/bezier_basis.cpp
+  src/bezier/bernstein_product.cpp
   src/bezier/pyramid_basis.cpp
 )

@@ -1,0 +1,80 @@
+#pragma once
+/// Certified bounds on the quality measure mu of curved elements (thesis, Paper V).
+///
+/// Definition. At each point of the reference element let J_p be the Jacobian matrix of
+/// the element map (derivatives in Gmsh's reference coordinates, lagrange_basis.hpp;
+/// 3 x dim) and J_i the constant Jacobian matrix from Gmsh's reference element to the
+/// ideal element of the family:
+///   triangle     equilateral triangle of side 1
+///   quadrangle   unit square
+///   tetrahedron  regular tetrahedron of edge 1
+///   hexahedron   unit cube
+///   prism        right prism on an equilateral triangle of side 1, height 1
+///   pyramid      unit square base, equilateral triangular faces (apex height 1/sqrt 2)
+/// (vertex i of the reference element goes to vertex i of the ideal; only the shape of the
+/// ideal matters, mu being scale invariant). With W = J_p J_i^-1 (3 x dim) and
+/// M = W^T W (Paper V eq. 2), the pointwise measure is
+///   mu_pw = sqrt(lambda_min(M) / lambda_max(M)) = sigma_min(W) / sigma_max(W)
+/// and  mu(E) = min over the element of mu_pw  when J > 0 everywhere on E,
+///      mu(E) = 0                              when J <= 0 somewhere on E,
+/// J the Jacobian determinant with the sign conventions of jacobian_bounds.hpp (2D
+/// elements in 3D: W is 3 x 2 and the sign is that of (X_xi x X_eta) . n; `planar`
+/// selects n = +z). Lines: mu = 1 when valid (W has one singular value), 0 otherwise.
+/// mu is invariant under similarities of the element and under renumberings of its nodes
+/// that keep the orientation (the ideal element has the symmetry group of the reference).
+///
+/// What is guaranteed. The node coordinates (doubles) are taken as exact. Validity is
+/// first settled with jacobian_bounds() (validity goal): invalid gives [0, 0] (mu = 0);
+/// undetermined gives lower = 0 and upper from values of mu_pw (tolerance_met only when
+/// upper <= abs_tol). For a valid element:
+///   lower <= mu(E) <= upper,
+/// with every floating-point rounding accounted for:
+///   - W's control values: exact rational maps from the nodes (Lagrange-to-Bézier of the
+///     geometry, Bernstein derivative, degree elevation) rounded once, J_i^-1 within 3u,
+///     and an a priori bound gamma_{N+dim+9} sum_c |J_i^-1| Gamma_c R on every value;
+///   - subdivision: exact dyadic matrices (rounding of their sums added per level);
+///   - products (Paper V Prop. 4, src/bezier/bernstein_product.hpp): convex combinations
+///     of f_i g_j, error bounded by the factors' errors and gamma_k;
+///   - a sign test on a control value passes only when it exceeds its error bound, and
+///     every reported number is rounded outward.
+/// lower: per subdomain, the largest r (bisection) with a certificate R >= r, R = mu_pw^2:
+///   2D (Paper V §4): a^2 = q^2 / (s^2 + t^2) >= rho from the control values (§3.1), then
+///      R >= (sqrt rho - 1) / (sqrt rho + 1);
+///   3D: R >= r  <=>  A >= 0 and A^2 - X^2 >= 0, A and X^2 polynomials in
+///      (q, p^2, det(M - qI)) or in the invariants of M (src/analysis/mu_metric.hpp), both
+///      certified nonnegative from their control values (Prop. 5). This is an exact
+///      pointwise equivalence (no closed form, no Newton step, nothing left unproven); it
+///      replaces the (a, K) bounding box and bounding curve of Paper V §5-6, whose bounds
+///      converge only linearly at a fold of the (a, K) image and lose all information on w
+///      near the ideal element (w = (K - a^3 + 3a) / 2 cancels).
+/// upper: the minimum over the corners of all subdomains of an upper bound of mu_pw there
+///   (Rayleigh quotients of W at approximate eigenvectors of W^T W, enclosed in interval
+///   fashion: lambda_min <= |W v|^2 / |v|^2 <= lambda_max for any v).
+/// Refinement is best-first (the subdomain with the smallest lower bound is split into its
+/// 2^dim children) until upper - lower <= abs_tol or max_subdivisions subdomains were
+/// split; tolerance_met says which.
+
+#include <span>
+
+#include "quadval/element_type.hpp"
+#include "quadval/quality_bounds.hpp"
+
+namespace quadval {
+
+/// True when mu_bounds handles this type: Lagrange lines (any order), triangles and
+/// quadrangles up to order 6, tetrahedra up to order 3, prisms and hexahedra up to order 2
+/// (complete and incomplete), within what jacobian_bounds_supported() accepts. The limit
+/// is the cost of the degree-12n certificate of 3D elements. Pyramids are not handled.
+bool mu_supported(const ElementType& type) noexcept;
+
+/// Certified bounds of mu(E) for one element. Thread-safe (thread_local scratch) and
+/// deterministic.
+/// @param type    the element type; @pre mu_supported(type) (QV_ASSERT otherwise)
+/// @param nodes   #nodes x 3 coordinates, Gmsh node order; @pre nodes.size() == 3 * #nodes
+/// @param options abs_tol (> 0) and max_subdivisions
+/// @param planar  2D only: J's sign with n = +z (jacobian_bounds.hpp)
+/// Thesis, Paper V §2-4 (2D), §5 (3D quantities); see above for the 3D certificate.
+QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
+                        const QualityOptions& options, bool planar = false);
+
+}  // namespace quadval

@@ -1,0 +1,199 @@
+// Certified bounds of the quality measure mu (thesis, Paper V): validity first (the
+// Jacobian engine), then best-first adaptive subdivision of the control values of W, each
+// subdomain bounded by mu_metric.cpp (lower) and by its corner values (upper).
+#include "quadval/mu_bounds.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <vector>
+
+#include "analysis/mu_metric.hpp"
+#include "analysis/mu_space.hpp"
+#include "analysis/outward_rounding.hpp"
+#include "quadval/error.hpp"
+#include "quadval/jacobian_bounds.hpp"
+
+namespace quadval {
+namespace {
+
+struct Subdomain {
+  double lower;  // certified lower bound of min R on it
+  double err;    // |control values - exact| <= err
+  int slot;      // its control values in the pool
+  bool operator>(const Subdomain& o) const {
+    return lower != o.lower ? lower > o.lower : slot > o.slot;
+  }
+};
+
+struct MuScratch {
+  MuMetric metric;
+  std::vector<double> pool;
+  std::vector<int> free_slots;
+  std::vector<double> sub_scratch;
+};
+
+// W's control values of the whole element (layout of MuMetric::lower_bound) and their
+// error bound: X_c = D_c (x - x_0) within gamma_{N+4} Gamma_c R (D entries 2u, differences
+// u, products and an N-term sum), then W_j = sum_c Jinv_cj X_c (Jinv entries 3u, a
+// dim-term sum): in all within gamma_{N+dim+9} sum_c |Jinv_cj| Gamma_c R.
+double element_w(const MuSpace& space, std::span<const double> x, double* w) {
+  const int dim = space.dim();
+  const int n = space.num_nodes();
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  double range = 0;
+  for (int i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      range = std::max(range, std::abs(x[static_cast<std::size_t>(3 * i + c)] - x[static_cast<std::size_t>(c)]));
+  const auto& jinv = space.ideal_inverse();
+  std::fill(w, w + static_cast<std::size_t>(dim * 3) * ws, 0.0);
+  for (std::size_t k = 0; k < ws; ++k) {
+    double xc[3][3] = {};
+    for (int c = 0; c < dim; ++c) {
+      const double* row = space.derivative(c).data() + k * static_cast<std::size_t>(n);
+      for (int i = 0; i < n; ++i) {
+        const double g = row[i];
+        if (g == 0) continue;
+        for (int a = 0; a < 3; ++a)
+          xc[c][a] += g * (x[static_cast<std::size_t>(3 * i + a)] - x[static_cast<std::size_t>(a)]);
+      }
+    }
+    for (int j = 0; j < dim; ++j)
+      for (int a = 0; a < 3; ++a) {
+        double v = 0;
+        for (int c = 0; c < dim; ++c) v += jinv[static_cast<std::size_t>(c * 3 + j)] * xc[c][a];
+        w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(a)) * ws + k] = v;
+      }
+  }
+  double worst = 0;
+  for (int j = 0; j < dim; ++j) {
+    double s = 0;
+    for (int c = 0; c < dim; ++c) s += std::abs(jinv[static_cast<std::size_t>(c * 3 + j)]) * space.derivative_row_sum(c);
+    worst = std::max(worst, s);
+  }
+  return rounding_gamma(n + dim + 9) * worst * range * (1 + 1e-12);
+}
+
+double sqrt_down(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_down(std::sqrt(r))); }
+double sqrt_up(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_up(std::sqrt(r))); }
+
+bool handled_family(ElementFamily f) {
+  switch (f) {
+    case ElementFamily::line:
+    case ElementFamily::triangle:
+    case ElementFamily::quadrangle:
+    case ElementFamily::tetrahedron:
+    case ElementFamily::prism:
+    case ElementFamily::hexahedron: return true;
+    default: return false;
+  }
+}
+
+}  // namespace
+
+bool mu_supported(const ElementType& type) noexcept {
+  return handled_family(type.family) && type.has_lagrange_basis && type.order >= 1 &&
+         type.order <= mu_max_order(type.family) && jacobian_bounds_supported(type);
+}
+
+QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
+                        const QualityOptions& options, bool planar) {
+  QV_ASSERT(mu_supported(type), "mu bounds do not handle " << type.name);
+  QV_ASSERT(nodes.size() == static_cast<std::size_t>(3 * type.num_nodes),
+            nodes.size() << " coordinates for " << type.name);
+  QV_ASSERT(options.abs_tol > 0, "abs_tol " << options.abs_tol);
+  thread_local BoundsWorkspace workspace;
+  thread_local MuScratch scratch;
+
+  BoundsOptions validity;
+  validity.goal = BoundsGoal::validity;
+  const JacobianBounds jb = jacobian_bounds(type, nodes, validity, workspace, planar);
+  QualityBounds out;
+  if (jb.validity == Validity::invalid) {
+    out.tolerance_met = true;  // mu = 0 exactly
+    return out;
+  }
+  if (type.family == ElementFamily::line) {
+    // One singular value: mu_pw = 1 wherever J > 0.
+    out.upper = 1;
+    out.lower = jb.validity == Validity::valid ? 1.0 : 0.0;
+    out.tolerance_met = out.upper - out.lower <= options.abs_tol;
+    return out;
+  }
+
+  const MuSpace& space = mu_space(type);
+  const BezierBasis& basis = space.w_basis();
+  const auto block = static_cast<std::size_t>(space.dim() * 3 * space.w_size());
+  auto& pool = scratch.pool;
+  auto& free_slots = scratch.free_slots;
+  free_slots.clear();
+  pool.resize(block);
+  const double err0 = element_w(space, nodes, pool.data());
+  double r_upper = corner_ratio_upper(space, pool.data(), err0);
+  if (jb.validity != Validity::valid) {
+    out.upper = sqrt_up(r_upper);
+    out.tolerance_met = out.upper <= options.abs_tol;
+    return out;
+  }
+
+  const auto tol_r = [&] {
+    // mu = sqrt(R): a bracket of width abs_tol * mu / 2 in R is about abs_tol / 4 in mu.
+    return 0.5 * options.abs_tol * std::max(std::sqrt(std::max(r_upper, 0.0)), options.abs_tol);
+  };
+  // A lower bound of R above (sqrt(R upper) - 0.9 abs_tol)^2 meets the tolerance.
+  const auto r_target = [&] {
+    const double m = std::sqrt(std::max(r_upper, 0.0)) - 0.9 * options.abs_tol;
+    return m <= 0 ? 0.0 : m * m;
+  };
+  std::priority_queue<Subdomain, std::vector<Subdomain>, std::greater<>> heap;
+  {
+    const double lo = scratch.metric.lower_bound(space, pool.data(), err0, 0, r_upper, r_target(), tol_r());
+    heap.push({lo, err0, 0});
+  }
+  int next_slot = 1;
+  const double sub_rounding = basis.subdivision_rounding();
+  scratch.sub_scratch.resize(2 * static_cast<std::size_t>(basis.size()));
+  const auto ws = static_cast<std::size_t>(basis.size());
+  const int vectors = space.dim() * 3;
+  while (true) {
+    const Subdomain top = heap.top();
+    out.lower = sqrt_down(top.lower);
+    out.upper = sqrt_up(r_upper);
+    if (out.upper - out.lower <= options.abs_tol) {
+      out.tolerance_met = true;
+      break;
+    }
+    if (out.subdivisions >= options.max_subdivisions) break;
+    heap.pop();
+    ++out.subdivisions;
+    double wmax = 0;
+    for (std::size_t i = 0; i < block; ++i)
+      wmax = std::max(wmax, std::abs(pool[static_cast<std::size_t>(top.slot) * block + i]));
+    // S_q exact, nonnegative, rows summing to 1: the parent's error carries over as is.
+    const double child_err = (top.err + sub_rounding * wmax) * (1 + 1e-12);
+    for (int q = 0; q < basis.num_children(); ++q) {
+      int slot;
+      if (!free_slots.empty()) {
+        slot = free_slots.back();
+        free_slots.pop_back();
+      } else {
+        slot = next_slot++;
+        pool.resize(static_cast<std::size_t>(next_slot) * block);
+      }
+      const auto child = static_cast<std::size_t>(slot) * block;
+      const auto par = static_cast<std::size_t>(top.slot) * block;  // pool may have moved
+      for (int v = 0; v < vectors; ++v)
+        basis.subdivide(q, pool.data() + par + static_cast<std::size_t>(v) * ws,
+                        pool.data() + child + static_cast<std::size_t>(v) * ws, scratch.sub_scratch.data());
+      const double corner = corner_ratio_upper(space, pool.data() + child, child_err);
+      r_upper = std::min(r_upper, corner);
+      const double lo = scratch.metric.lower_bound(space, pool.data() + child, child_err, top.lower,
+                                                   std::min(corner, r_upper), r_target(), tol_r());
+      heap.push({lo, child_err, slot});
+    }
+    free_slots.push_back(top.slot);
+  }
+  return out;
+}
+
+}  // namespace quadval

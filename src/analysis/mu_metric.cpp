@@ -1,0 +1,376 @@
+// Per-subdomain bounds of R = lambda_min / lambda_max (see mu_metric.hpp for the method).
+// Error model: every polynomial carries (coefficients c, err, mag = max|c|); the exact
+// polynomial's control values lie within err of c. A product sum_t s_t f_t g_t has error
+// sum |s| (F e_g + e_f G + e_f e_g) + rounding(k) sum |s| F G (bernstein_product.hpp),
+// F = max|f|; a coefficient-wise combination sum a_i f_i with k terms has error
+// sum |a_i| e_i + gamma_{k+2} sum |a_i| F_i (sum, scale products, and constants such as
+// 1/3 rounded to double). Error bounds are computed in double and enlarged by 1e-12
+// relative, which covers their own rounding.
+#include "analysis/mu_metric.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+
+#include "analysis/outward_rounding.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kSlack = 1 + 1e-12;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double max_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
+// Largest rho (rounded down) with rho * D <= N certified coefficient-wise (Paper V §3.1,
+// both signs of the denominator); -inf when no rho satisfies every coefficient, +inf when
+// every constraint is a lower limit.
+double ratio_lower_bound(const std::vector<double>& n, double en, const std::vector<double>& d,
+                         double ed) {
+  double lower = -kInf, upper = kInf;
+  for (std::size_t i = 0; i < n.size(); ++i) {
+    const double n_lo = next_down(n[i] - en);
+    for (double dv : {next_down(d[i] - ed), next_up(d[i] + ed)}) {
+      if (dv > 0) {
+        upper = std::min(upper, next_down(n_lo / dv));
+      } else if (dv < 0) {
+        lower = std::max(lower, next_up(n_lo / dv));
+      } else if (n_lo < 0) {
+        return -kInf;
+      }
+    }
+  }
+  return lower <= upper ? upper : -kInf;
+}
+
+}  // namespace
+
+void MuMetric::product(const BernsteinProduct& table,
+                       std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms,
+                       Poly& out) {
+  out.c.assign(static_cast<std::size_t>(table.h_size()), 0.0);
+  double prop = 0, scale_fg = 0;
+  int k = 0;
+  for (const auto& [s, f, g] : terms) {
+    table.multiply_add(f->c.data(), g->c.data(), s, out.c.data());
+    prop += std::abs(s) * (f->mag * g->err + f->err * g->mag + f->err * g->err);
+    scale_fg += std::abs(s) * f->mag * g->mag;
+    ++k;
+  }
+  out.err = (prop + table.rounding(k) * scale_fg) * kSlack;
+  out.mag = max_abs(out.c);
+}
+
+double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
+                             double r_hi, double r_target, double tol_r) {
+  const int dim = space.dim();
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  for (int j = 0; j < dim * 3; ++j) {
+    Poly& p = w_[j];
+    p.c.assign(w + static_cast<std::size_t>(j) * ws, w + static_cast<std::size_t>(j + 1) * ws);
+    p.err = err;
+    p.mag = max_abs(p.c);
+  }
+  const BernsteinProduct& p11 = space.prod(1, 1);
+  const BernsteinProduct& p22 = space.prod(2, 2);
+  const auto dot = [&](int a, int b, Poly& out) {
+    product(p11, {{1.0, &w_[3 * a], &w_[3 * b]}, {1.0, &w_[3 * a + 1], &w_[3 * b + 1]},
+                  {1.0, &w_[3 * a + 2], &w_[3 * b + 2]}},
+            out);
+  };
+  // out = sum a_i f_i coefficient-wise, with its error bound.
+  const auto combine = [](std::initializer_list<std::pair<double, const Poly*>> terms, Poly& out) {
+    const std::size_t n = terms.begin()->second->c.size();
+    out.c.assign(n, 0.0);
+    double e = 0, m = 0;
+    int k = 0;
+    for (const auto& [a, f] : terms) {
+      for (std::size_t i = 0; i < n; ++i) out.c[i] += a * f->c[i];
+      e += std::abs(a) * f->err;
+      m += std::abs(a) * f->mag;
+      ++k;
+    }
+    out.err = (e + rounding_gamma(k + 2) * m) * kSlack;
+    out.mag = max_abs(out.c);
+  };
+
+  if (dim == 2) {
+    dot(0, 0, m_[0]);
+    dot(1, 1, m_[1]);
+    dot(0, 1, m_[3]);
+    combine({{0.5, &m_[0]}, {0.5, &m_[1]}}, q_);
+    combine({{0.5, &m_[0]}, {-0.5, &m_[1]}}, s_);
+    product(p22, {{1.0, &q_, &q_}}, q2_);
+    product(p22, {{1.0, &s_, &s_}, {1.0, &m_[3], &m_[3]}}, n2_);
+    // a^2 = q^2 / (s^2 + t^2) >= rho; R = (a - 1) / (a + 1) increasing in a (§4).
+    const double rho = ratio_lower_bound(q2_.c, q2_.err, n2_.c, n2_.err);
+    double r = 0;
+    if (rho == kInf) {
+      r = 1;
+    } else if (rho > 1) {
+      const double a = next_down(std::sqrt(rho));
+      r = std::max(0.0, next_down(next_down(a - 1) / next_up(a + 1)));
+    }
+    return std::max(r_lo, std::min(r, 1.0));
+  }
+
+  // 3D: metric entries, q, D = M - q I, p^2 = tr D^2 / 6, e3 = det D.
+  dot(0, 0, m_[0]);
+  dot(1, 1, m_[1]);
+  dot(2, 2, m_[2]);
+  dot(0, 1, m_[3]);
+  dot(0, 2, m_[4]);
+  dot(1, 2, m_[5]);
+  combine({{1.0 / 3, &m_[0]}, {1.0 / 3, &m_[1]}, {1.0 / 3, &m_[2]}}, q_);
+  for (int i = 0; i < 3; ++i) combine({{1.0, &m_[i]}, {-1.0, &q_}}, d_[i]);
+  product(p22, {{1.0 / 6, &d_[0], &d_[0]}, {1.0 / 6, &d_[1], &d_[1]}, {1.0 / 6, &d_[2], &d_[2]},
+                {1.0 / 3, &m_[3], &m_[3]}, {1.0 / 3, &m_[4], &m_[4]}, {1.0 / 3, &m_[5], &m_[5]}},
+          p2_);
+  product(p22, {{1.0, &q_, &q_}}, q2_);
+  // Cheap bound: a = q / p >= sqrt(rho); lambda = q + p y with y_max - y_min <= 2 sqrt 3
+  // and y_max >= 1, so R = 1 - (y_max - y_min) / (a + y_max) >= 1 - 2 sqrt 3 / (a + 1).
+  double lo = r_lo;
+  {
+    const double rho = ratio_lower_bound(q2_.c, q2_.err, p2_.c, p2_.err);
+    if (rho == kInf) {
+      lo = std::max(lo, next_down(1.0));
+    } else if (rho > 1) {
+      const double a = next_down(std::sqrt(rho));
+      const double cheap = next_down(1 - next_up(3.4641016151377553 / next_down(a + 1)));
+      lo = std::max(lo, cheap);
+    }
+  }
+  r_hi = std::min(r_hi, 1.0);
+  if (!(r_hi - lo > tol_r) || lo >= r_target) return lo;
+
+  const BernsteinProduct& p42 = space.prod(4, 2);
+  const BernsteinProduct& p66 = space.prod(6, 6);
+  const BernsteinProduct& p44 = space.prod(4, 4);
+  const BernsteinProduct& p84 = space.prod(8, 4);
+  // Two exact forms of A and Pi_r: in (q, p^2, e3 = det D), whose terms are of the size of
+  // the result near the ideal element (R near 1), and in the invariants of M
+  // (I1 = tr M, I2 = sum of principal 2x2 minors, I3 = det M), whose terms are of the size
+  // of the result near degeneracy (R near 0). The subdomain's upper bound picks one.
+  invariant_form_ = r_hi < 0.25;
+  if (!invariant_form_) {
+    product(p22, {{1.0, &d_[0], &d_[1]}}, de_[0]);
+    product(p22, {{1.0, &m_[3], &m_[4]}}, de_[1]);
+    product(p22, {{1.0, &m_[5], &m_[5]}}, de_[2]);
+    product(p22, {{1.0, &m_[4], &m_[4]}}, de_[3]);
+    product(p22, {{1.0, &m_[3], &m_[3]}}, de_[4]);
+    product(p42, {{1.0, &de_[0], &d_[2]}, {2.0, &de_[1], &m_[5]}, {-1.0, &de_[2], &d_[0]},
+                  {-1.0, &de_[3], &d_[1]}, {-1.0, &de_[4], &d_[2]}},
+            e3_);
+    product(p42, {{1.0, &q2_, &q_}}, q3_);
+    product(space.prod(2, 4), {{1.0, &q_, &p2_}}, qp2_);
+    product(p44, {{1.0, &p2_, &p2_}}, p4_);
+    product(p84, {{1.0, &p4_, &p2_}}, big_[3]);
+    product(p66, {{1.0, &e3_, &e3_}}, big_[6]);
+    // First try, directly as A^2 - X^2 (3 products of degree 12n instead of 7): most
+    // subdomains only need to clear the target, and only those near the minimum bisect.
+    const double first = std::min(r_hi - 0.5 * tol_r, r_target);
+    if (first > lo && first < 1) {
+      if (certify_direct(p66, first)) return first;
+      r_hi = first;
+    }
+    product(p66, {{1.0, &q3_, &q3_}}, big_[0]);
+    product(p44, {{1.0, &q2_, &p2_}}, q2p2_);
+    product(p84, {{1.0, &q2p2_, &q2_}}, big_[1]);
+    product(p84, {{1.0, &q2p2_, &p2_}}, big_[2]);
+    product(p66, {{1.0, &q3_, &e3_}}, big_[4]);
+    product(p66, {{1.0, &qp2_, &e3_}}, big_[5]);
+  } else {
+    Poly& i1 = q3_;   // reused buffers: I1 (2n), I2 (4n), I3 (6n), I1 I2 (6n)
+    Poly& i2 = q2p2_;
+    Poly& i3 = e3_;
+    Poly& i1i2 = qp2_;
+    combine({{1.0, &m_[0]}, {1.0, &m_[1]}, {1.0, &m_[2]}}, i1);
+    product(p22, {{1.0, &m_[0], &m_[1]}, {-1.0, &m_[3], &m_[3]}, {1.0, &m_[0], &m_[2]},
+                  {-1.0, &m_[4], &m_[4]}, {1.0, &m_[1], &m_[2]}, {-1.0, &m_[5], &m_[5]}},
+            i2);
+    // det M = m00 (m11 m22 - m12^2) - m01 (m01 m22 - m12 m02) + m02 (m01 m12 - m11 m02)
+    product(p22, {{1.0, &m_[1], &m_[2]}, {-1.0, &m_[5], &m_[5]}}, de_[0]);
+    product(p22, {{1.0, &m_[3], &m_[2]}, {-1.0, &m_[5], &m_[4]}}, de_[1]);
+    product(p22, {{1.0, &m_[3], &m_[5]}, {-1.0, &m_[1], &m_[4]}}, de_[2]);
+    product(p42, {{1.0, &de_[0], &m_[0]}, {-1.0, &de_[1], &m_[3]}, {1.0, &de_[2], &m_[4]}}, i3);
+    product(space.prod(2, 4), {{1.0, &i1, &i2}}, i1i2);
+    product(p66, {{1.0, &i3, &i3}}, big_[0]);
+    product(p44, {{1.0, &i2, &i2}}, p4_);
+    product(p84, {{1.0, &p4_, &i2}}, big_[1]);
+    product(p66, {{1.0, &i1i2, &i3}}, big_[2]);
+    product(p22, {{1.0, &i1, &i1}}, tmp_);
+    product(p84, {{1.0, &p4_, &tmp_}}, big_[3]);
+    product(p42, {{1.0, &tmp_, &i1}}, de_[3]);
+    product(p66, {{1.0, &de_[3], &i3}}, big_[4]);
+  }
+
+  // One try at the target (the invariant form), then bisection below it.
+  double hi = r_hi;
+  if (invariant_form_) {
+    const double first = std::min(r_hi - 0.5 * tol_r, r_target);
+    if (first > lo && first < 1) {
+      if (certify_3d(first)) return first;
+      hi = first;
+    }
+  }
+  for (int it = 0; it < 60 && hi - lo > tol_r; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    if (mid >= 1) break;
+    (certify_3d(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+bool MuMetric::certify_direct(const BernsteinProduct& p66, double r) {
+  // A = s^3 q^3 - 3 t s q p^2 + s v e3 / 2 (6n), then Pi = A^2 - c (4 p^6 - e3^2) with
+  // c = (27/4) r^2 (r+1)^2 (mu_metric.hpp).
+  const double s = 1 - r, t = r * r + r + 1, v = (r + 2) * (2 * r + 1);
+  const double a0 = s * s * s, a1 = -3 * t * s, a2 = 0.5 * s * v;
+  const std::size_t na = q3_.c.size();
+  a_.c.resize(na);
+  for (std::size_t i = 0; i < na; ++i) a_.c[i] = a0 * q3_.c[i] + a1 * qp2_.c[i] + a2 * e3_.c[i];
+  const double m = std::abs(a0) * q3_.mag + std::abs(a1) * qp2_.mag + std::abs(a2) * e3_.mag;
+  a_.err = (std::abs(a0) * (q3_.err + 1e-14 * q3_.mag) + std::abs(a1) * (qp2_.err + 1e-14 * qp2_.mag) +
+            std::abs(a2) * (e3_.err + 1e-14 * e3_.mag) + rounding_gamma(5) * m) * kSlack;
+  a_.mag = max_abs(a_.c);
+  for (double x : a_.c)
+    if (!(x >= a_.err)) return false;
+  product(p66, {{1.0, &a_, &a_}}, tmp_);
+  const double c = 6.75 * r * r * (r + 1) * (r + 1);
+  const Poly& p6 = big_[3];
+  const Poly& e6 = big_[6];
+  const double err = (tmp_.err + c * (4 * (p6.err + 1e-14 * p6.mag) + e6.err + 1e-14 * e6.mag) +
+                      rounding_gamma(5) * (tmp_.mag + c * (4 * p6.mag + e6.mag))) * kSlack;
+  for (std::size_t i = 0; i < tmp_.c.size(); ++i)
+    if (!(tmp_.c[i] - c * (4 * p6.c[i] - e6.c[i]) >= err)) return false;
+  return true;
+}
+
+bool MuMetric::certify_3d(double r) {
+  // Coefficients of A and Pi_r in the chosen form (mu_metric.hpp; exact identities checked
+  // by the tests against C_- = (l2 - r l1)(l3 - r l2)(l1 - r l3)). All factors are positive
+  // for r in [0, 1), so each coefficient is within 1e-14 relative of its exact value.
+  const double s = 1 - r, t = r * r + r + 1, v = (r + 2) * (2 * r + 1);
+  const double s2 = s * s, s3 = s2 * s, s4 = s2 * s2;
+  double a_coef[3], g[7];
+  const Poly* a_poly[3];
+  const Poly* b_poly[7];
+  int na_terms, nb_terms;
+  if (!invariant_form_) {
+    // A = u^3 - 3 t u p^2 + s v e3 / 2, u = s q; Pi = A^2 - (27/4) r^2 (r+1)^2 (4 p^6 - e3^2).
+    a_coef[0] = s3, a_coef[1] = -3 * t * s, a_coef[2] = 0.5 * s * v;
+    a_poly[0] = &q3_, a_poly[1] = &qp2_, a_poly[2] = &e3_;
+    na_terms = 3;
+    const double gv[7] = {s3 * s3, -6 * t * s4, 9 * t * t * s2, -27 * r * r * (r + 1) * (r + 1),
+                          s4 * v, -3 * s2 * v * t, t * t * t};
+    std::copy(gv, gv + 7, g);
+    for (int m = 0; m < 7; ++m) b_poly[m] = &big_[m];
+    nb_terms = 7;
+  } else {
+    // A = s v I3 / 2 - r s I1 I2 / 2;
+    // Pi = t^3 I3^2 + r^2 (r+1)^2 I2^3 - r t (r^2 + 4r + 1) I1 I2 I3 - r^3 I1^2 I2^2
+    //      + r^2 (r+1)^2 I1^3 I3.
+    a_coef[0] = 0.5 * s * v, a_coef[1] = -0.5 * r * s;
+    a_poly[0] = &e3_, a_poly[1] = &qp2_;
+    na_terms = 2;
+    const double rr = r * r * (r + 1) * (r + 1);
+    const double gv[5] = {t * t * t, rr, -r * t * (r * r + 4 * r + 1), -r * r * r, rr};
+    std::copy(gv, gv + 5, g);
+    for (int m = 0; m < 5; ++m) b_poly[m] = &big_[m];
+    nb_terms = 5;
+  }
+  const auto bound = [](const double* coef, const Poly* const* polys, int k) {
+    double e = 0, m = 0;
+    for (int i = 0; i < k; ++i) {
+      e += std::abs(coef[i]) * (polys[i]->err + 1e-14 * polys[i]->mag);
+      m += std::abs(coef[i]) * polys[i]->mag;
+    }
+    return (e + rounding_gamma(k + 2) * m) * kSlack;
+  };
+  const double err_a = bound(a_coef, a_poly, na_terms);
+  const std::size_t na = a_poly[0]->c.size();
+  for (std::size_t i = 0; i < na; ++i) {
+    double a = 0;
+    for (int m = 0; m < na_terms; ++m) a += a_coef[m] * a_poly[m]->c[i];
+    if (!(a >= err_a)) return false;
+  }
+  const double err_pi = bound(g, b_poly, nb_terms);
+  const std::size_t nb = b_poly[0]->c.size();
+  for (std::size_t i = 0; i < nb; ++i) {
+    double x = 0;
+    for (int m = 0; m < nb_terms; ++m) x += g[m] * b_poly[m]->c[i];
+    if (!(x >= err_pi)) return false;
+  }
+  return true;
+}
+
+namespace {
+
+// Upper bound of R at one corner: W (3 x D, fixed size: no allocation per corner).
+template <int D>
+double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err) {
+  const Eigen::Matrix<double, D, D> m = wm.transpose() * wm;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig(m);
+  if (eig.info() != Eigen::Success) return 1;
+  // Rayleigh quotient |W v|^2 / |v|^2, enclosed: y_c = sum_j w_cj v_j within
+  // err sum|v| + gamma_4 sum |w_cj v_j| (+1e-12 relative for the bound's own rounding).
+  const auto rayleigh = [&](const Eigen::Matrix<double, D, 1>& v, bool upper) {
+    double y2 = 0, v2 = 0, vsum = 0;
+    for (int j = 0; j < D; ++j) {
+      v2 += v(j) * v(j);
+      vsum += std::abs(v(j));
+    }
+    for (int c = 0; c < 3; ++c) {
+      double y = 0, mag = 0;
+      for (int j = 0; j < D; ++j) {
+        y += wm(c, j) * v(j);
+        mag += std::abs(wm(c, j) * v(j));
+      }
+      const double rad = (err * vsum + rounding_gamma(4) * mag) * kSlack;
+      const double e = upper ? std::abs(y) + rad : std::max(0.0, std::abs(y) - rad);
+      y2 += e * e;
+    }
+    // Sums of squares and the quotient: relative error <= gamma_6 each.
+    const double g = rounding_gamma(6) * kSlack;
+    return upper ? y2 * (1 + g) / (v2 * (1 - g)) * (1 + g) : y2 * (1 - g) / (v2 * (1 + g)) * (1 - g);
+  };
+  const double lmin_hi = rayleigh(eig.eigenvectors().col(0), true);
+  const double lmax_lo = rayleigh(eig.eigenvectors().col(D - 1), false);
+  if (!(lmax_lo > 0) || !std::isfinite(lmin_hi)) return 1;
+  return next_up(lmin_hi / lmax_lo);
+}
+
+}  // namespace
+
+double corner_ratio_upper(const MuSpace& space, const double* w, double err) {
+  const int dim = space.dim();
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  const auto at = [&](int j, int c, int k) {
+    return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + static_cast<std::size_t>(k)];
+  };
+  double best = 1;
+  for (const int k : space.w_basis().vertex_indices()) {
+    if (dim == 2) {
+      Eigen::Matrix<double, 3, 2> wm;
+      for (int j = 0; j < 2; ++j)
+        for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c, k);
+      best = std::min(best, corner_upper<2>(wm, err));
+    } else {
+      Eigen::Matrix<double, 3, 3> wm;
+      for (int j = 0; j < 3; ++j)
+        for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c, k);
+      best = std::min(best, corner_upper<3>(wm, err));
+    }
+  }
+  return best;
+}
+
+}  // namespace quadval

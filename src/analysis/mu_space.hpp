@@ -1,0 +1,72 @@
+#pragma once
+// The precomputed data of the measure mu for one element type (thesis, Paper V §2-5):
+// the Bézier space of the entries of W = J_p J_i^-1, the exact linear maps from the node
+// coordinates to the control values of the derivatives X_xi, X_eta, X_zeta in that space,
+// the inverse ideal Jacobian J_i^-1, and the Bernstein product tables of the metric
+// polynomials. Built once per type, immutable, shared by all threads. Internal.
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "bezier/bernstein_product.hpp"
+#include "quadval/bezier_basis.hpp"
+#include "quadval/element_type.hpp"
+
+namespace quadval {
+
+/// Highest order of each family whose metric polynomials are bounded (the degree-12n
+/// certificate of 3D elements grows as (12 n)^3 coefficients and its products as the
+/// square of the degree-6n spaces): triangles and quadrangles 6, tetrahedra 3, prisms and
+/// hexahedra 2; lines 10 (mu is 1 or 0); 0 for pyramids and other families.
+int mu_max_order(ElementFamily family) noexcept;
+
+class MuSpace {
+ public:
+  /// @pre type a Lagrange triangle, quadrangle, tetrahedron, prism or hexahedron of order
+  ///      1..mu_max_order(family)
+  explicit MuSpace(const ElementType& type);
+
+  const ElementType& type() const noexcept { return *type_; }
+  int dim() const noexcept { return dim_; }
+  int num_nodes() const noexcept { return num_nodes_; }
+
+  /// The space of the entries of W: degree n per factor (simplices p - 1; quadrangles,
+  /// prisms, hexahedra p in every factor, the derivative factor degree-elevated).
+  const BezierBasis& w_basis() const noexcept { return *w_basis_; }
+  int w_size() const noexcept { return w_basis_->size(); }
+  /// Degrees m n per factor, m in {1, 2, 4, 6, 8, 12} (3D; 2D: 1, 2, 4).
+  const std::vector<FactorDegree>& degrees(int m) const noexcept { return degrees_[m]; }
+  int size(int m) const noexcept { return sizes_[m]; }
+
+  /// Control value k of dX/dxi_c (Gmsh reference coordinates) = sum_i
+  /// derivative(c)[k * num_nodes + i] * (x_i - x_0); entries within 2u of the exact
+  /// rationals (relative). c < dim().
+  const std::vector<double>& derivative(int c) const noexcept { return deriv_[c]; }
+  /// max_k sum_i |derivative(c)[k, i]|, rounded up to cover the exact entries.
+  double derivative_row_sum(int c) const noexcept { return row_sum_[c]; }
+
+  /// J_i^-1 (dim x dim, row-major) of the ideal element (mu_bounds.hpp), each entry within
+  /// 3u of the exact real number (relative).
+  const std::array<double, 9>& ideal_inverse() const noexcept { return ideal_inv_; }
+
+  /// Product tables (degrees in units of n): (1, 1), (2, 2); 3D also (4, 2), (2, 4),
+  /// (4, 4), (8, 4), (6, 6).
+  const BernsteinProduct& prod(int a, int b) const;
+
+ private:
+  const ElementType* type_;
+  int dim_ = 0;
+  int num_nodes_ = 0;
+  std::unique_ptr<BezierBasis> w_basis_;
+  std::vector<FactorDegree> degrees_[13];
+  int sizes_[13] = {};
+  std::vector<double> deriv_[3];
+  double row_sum_[3] = {};
+  std::array<double, 9> ideal_inv_{};
+  std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> prod_;
+};
+
+/// The shared space of `type`; thread-safe, built once.
+const MuSpace& mu_space(const ElementType& type);
+
+}  // namespace quadval

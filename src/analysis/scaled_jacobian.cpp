@@ -1,0 +1,394 @@
+// Certified bounds on the minimum of the scaled Jacobian (scaled_jacobian.hpp): Bézier
+// coefficients of the columns of J_p in their own degrees (an exact linear map of the
+// nodes, rounded once), N and D_k by Bernstein products (Paper V Prop. 4) with a priori
+// error bounds, then the rational-function bound of Paper V §3.1 refined by best-first
+// subdivision.
+#include "quadval/scaled_jacobian.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <vector>
+
+#include "analysis/jacobian_samples.hpp"
+#include "analysis/outward_rounding.hpp"
+#include "analysis/scaled_jacobian_space.hpp"
+#include "bezier/bernstein_product.hpp"
+#include "quadval/error.hpp"
+#include "quadval/jacobian_bounds.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kUnit = 0x1p-53;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+double down(double x) { return next_down(x); }
+double up(double x) { return next_up(x); }
+
+// A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
+// rounding of at most u per operation; the final bounds are enlarged by 1% to cover the
+// rounding of these bound computations themselves).
+struct Eb {
+  double m = 0, e = 0;
+};
+
+double max_abs(const double* x, std::size_t n) {
+  double m = 0;
+  for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::abs(x[i]));
+  return m;
+}
+
+struct Leaf {
+  double lower;
+  int slot;
+  long id;  // creation order: a deterministic tie-break
+};
+
+struct Scratch {
+  std::vector<double> values, work;
+  std::vector<double> pool, pool_err;
+  std::vector<int> free_slots;
+  std::vector<Leaf> heap;
+};
+
+// Bounds the quantities of one subdomain (or one point) need: vectors J, N, D_0..D_{K-1}
+// of `size` coefficients each at v[q * size], their error bounds err[q].
+class Bounder {
+ public:
+  /// valid: J > 0 is proven on the whole element (jacobian_bounds), so every subdomain
+  /// takes the positive branch without its own coefficient test.
+  Bounder(const ScaledJacobianSpace& space, std::size_t size, bool valid)
+      : space_(space), size_(size), frames_(space.frames().size()), valid_(valid) {}
+
+  // Certified lower bound of sj on the subdomain (see scaled_jacobian.hpp).
+  double lower(const double* v, const double* err) const {
+    const double* j = v;
+    const double* n = v + size_;
+    bool positive = true;
+    for (std::size_t i = 0; i < size_ && positive && !valid_; ++i) positive = down(j[i] - err[0]) > 0;
+    if (positive) {
+      double r = kInf;
+      for (std::size_t k = 0; k < frames_; ++k) {
+        const double* d = v + (2 + k) * size_;
+        const double ed = err[2 + k];
+        for (std::size_t i = 0; i < size_; ++i) {
+          const double d_lo = down(d[i] - ed);
+          if (!(d_lo > 0)) return 0;  // relaxation fails here; J > 0 gives sj > 0
+          const double n_lo = down(n[i] - err[1]);
+          r = std::min(r, n_lo >= 0 ? down(n_lo / up(d[i] + ed)) : down(n_lo / d_lo));
+        }
+      }
+      return down(space_.s_lo() * down(std::sqrt(std::max(0.0, r))));
+    }
+    // J not proven positive: sj >= -s sqrt(max N / D_k), and |sj| <= s (Hadamard).
+    double ub = 0;
+    for (std::size_t k = 0; k < frames_ && ub <= 1; ++k) {
+      const double* d = v + (2 + k) * size_;
+      const double ed = err[2 + k];
+      for (std::size_t i = 0; i < size_; ++i) {
+        const double d_lo = down(d[i] - ed);
+        if (!(d_lo > 0)) {
+          ub = 1;
+          break;
+        }
+        ub = std::max(ub, up(std::max(0.0, up(n[i] + err[1])) / d_lo));
+      }
+    }
+    ub = std::min(ub, 1.0);
+    return -up(space_.s_hi() * up(std::sqrt(ub)));
+  }
+
+  // Certified upper bound of sj at the point where the vectors' entry i are values.
+  double point_upper(const double* v, const double* err, std::size_t i) const {
+    const double jv = v[i], nv = v[size_ + i];
+    if (valid_ || down(jv - err[0]) > 0 || !(up(jv + err[0]) < 0)) {
+      // J > 0 (or unknown: then sj <= 0 or sj = s min_k sqrt(N/D_k)).
+      double val = space_.s_hi();
+      for (std::size_t k = 0; k < frames_; ++k) {
+        const double d_lo = down(v[(2 + k) * size_ + i] - err[2 + k]);
+        if (!(d_lo > 0)) continue;
+        const double q = up(std::max(0.0, up(nv + err[1])) / d_lo);
+        val = std::min(val, up(space_.s_hi() * up(std::sqrt(q))));
+      }
+      return val;
+    }
+    // J < 0: sj = -s max_k sqrt(N / D_k) <= -s sqrt(N / D_k) for every k.
+    double val = 0;
+    for (std::size_t k = 0; k < frames_; ++k) {
+      const double d_hi = up(v[(2 + k) * size_ + i] + err[2 + k]);
+      const double q = down(std::max(0.0, down(nv - err[1])) / d_hi);
+      val = std::min(val, -down(space_.s_lo() * down(std::sqrt(q))));
+    }
+    return val;
+  }
+
+ private:
+  const ScaledJacobianSpace& space_;
+  std::size_t size_, frames_;
+  bool valid_;
+};
+
+// A coefficient vector with its bounds: |entries| <= m (computed), |entry - exact| <= e.
+struct Poly {
+  std::vector<FactorDegree> deg;
+  std::vector<double> c;
+  Eb b;
+};
+
+void refresh_magnitude(Poly& p) { p.b.m = max_abs(p.c.data(), p.c.size()); }
+
+// h = sum_t scale_t f_t g_t (Paper V Prop. 4), all pairs (f_t, g_t) of the same two
+// spaces; error: propagated input errors plus bernstein_product's rounding bound.
+Poly product_sum(const std::vector<std::pair<const Poly*, const Poly*>>& terms, const std::vector<double>& scales) {
+  // The shared tables, looked up once per thread and degree pair (no lock per product).
+  thread_local std::map<std::vector<int>, const BernsteinProduct*> tables;
+  std::vector<int> key;
+  for (const Poly* p : {terms[0].first, terms[0].second})
+    for (const FactorDegree& fd : p->deg) key.insert(key.end(), {fd.dim, fd.degree});
+  const BernsteinProduct*& slot = tables[key];
+  if (slot == nullptr) slot = &bernstein_product(terms[0].first->deg, terms[0].second->deg);
+  const BernsteinProduct& table = *slot;
+  Poly h;
+  h.deg = product_degrees(terms[0].first->deg, terms[0].second->deg);
+  h.c.assign(static_cast<std::size_t>(table.h_size()), 0.0);
+  double magnitude = 0, propagated = 0;
+  for (std::size_t t = 0; t < terms.size(); ++t) {
+    const Poly& f = *terms[t].first;
+    const Poly& g = *terms[t].second;
+    table.multiply_add(f.c.data(), g.c.data(), scales[t], h.c.data());
+    const double sc = std::abs(scales[t]);
+    magnitude += sc * f.b.m * g.b.m;
+    propagated += sc * (f.b.m * g.b.e + (g.b.m + g.b.e) * f.b.e);
+  }
+  refresh_magnitude(h);
+  h.b.e = propagated + table.rounding(static_cast<int>(terms.size())) * magnitude;
+  return h;
+}
+
+// p = sum_t w_t q_t (same space), w_t in {-1, 1} or |w_t| <= 1 (a reference direction).
+Poly linear_sum(const std::vector<const Poly*>& q, const std::vector<double>& w) {
+  Poly p;
+  p.deg = q[0]->deg;
+  p.c.assign(q[0]->c.size(), 0.0);
+  double e = 0, m = 0;
+  for (std::size_t t = 0; t < q.size(); ++t) {
+    QV_ASSERT(q[t]->c.size() == p.c.size(), "spaces differ");
+    for (std::size_t i = 0; i < p.c.size(); ++i) p.c[i] += w[t] * q[t]->c[i];
+    e += std::abs(w[t]) * q[t]->b.e;
+    m += std::abs(w[t]) * q[t]->b.m;
+  }
+  refresh_magnitude(p);
+  // Each product w q rounds once (exact for w = +-1) and each of the q.size() - 1 sums once.
+  p.b.e = e + rounding_gamma(2 * static_cast<int>(q.size())) * m;
+  return p;
+}
+
+}  // namespace
+
+QualityBounds scaled_jacobian_bounds(const ElementType& type, std::span<const double> nodes,
+                                     const QualityOptions& options, bool planar) {
+  QV_ASSERT(scaled_jacobian_supported(type), "no scaled Jacobian for " << type.name);
+  // The sign of J on the whole element, settled by the Jacobian engine (certified, with
+  // its exact fallback).
+  thread_local BoundsWorkspace jacobian_ws;
+  BoundsOptions validity;
+  validity.goal = BoundsGoal::validity;
+  validity.max_subdivisions = options.max_subdivisions;
+  const Validity v = jacobian_bounds(type, nodes, validity, jacobian_ws, planar).validity;
+  return scaled_jacobian_bounds_given(type, nodes, options, planar, v);
+}
+
+QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
+                                           const QualityOptions& options, bool planar, Validity v) {
+  QV_ASSERT(scaled_jacobian_supported(type), "no scaled Jacobian for " << type.name);
+  QV_ASSERT(nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
+            "nodes " << nodes.size() << " for " << type.name);
+  thread_local Scratch ws;
+  const ScaledJacobianSpace& space = scaled_jacobian_space(type);
+  const BezierBasis& b2 = space.squared();
+  const auto s2 = static_cast<std::size_t>(b2.size());
+  const int dim = type.dim;
+  const auto udim = static_cast<std::size_t>(dim);
+  const auto nn = static_cast<std::size_t>(type.num_nodes);
+  const std::size_t frames = space.frames().size();
+  const std::size_t nvec = 2 + frames;
+
+  // 1. Bézier coefficients of the columns of J_p in their own degrees: an exact linear
+  //    map of x_i - x_0 (the maps' rows sum to zero: the translation is exact in the
+  //    definition); error (2u entries + u differences + gamma_N sums) * row sum * R.
+  double range = 0;
+  ws.values.resize(nn * 3);
+  for (std::size_t i = 0; i < nn; ++i)
+    for (std::size_t j = 0; j < 3; ++j) {
+      ws.values[i * 3 + j] = nodes[3 * i + j] - nodes[j];
+      range = std::max(range, std::abs(ws.values[i * 3 + j]));
+    }
+  std::array<std::array<Poly, 3>, 3> col;
+  for (std::size_t c = 0; c < udim; ++c) {
+    const std::vector<double>& m = space.column_map(static_cast<int>(c));
+    const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
+    const double e = (4 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c)) * range * 1.01;
+    for (std::size_t j = 0; j < 3; ++j) {
+      Poly& p = col[c][j];
+      p.deg = space.column_degrees(static_cast<int>(c));
+      p.c.assign(rows, 0.0);
+      for (std::size_t r = 0; r < rows; ++r) {
+        double sum = 0;
+        for (std::size_t i = 0; i < nn; ++i) sum += m[r * nn + i] * ws.values[i * 3 + j];
+        p.c[r] = sum;
+      }
+      refresh_magnitude(p);
+      p.b.e = e;
+    }
+  }
+
+  // 2. J, N = |V|^2 and D_k = prod_j |v_kj|^2 by Bernstein products.
+  const auto ref = reference_direction(type, nodes.data(), planar);
+  const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2
+  Poly jac, n;
+  if (dim == 3) {
+    std::array<Poly, 3> w;  // c_1 x c_2
+    for (std::size_t x = 0; x < 3; ++x) {
+      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
+      w[x] = product_sum({{&col[1][y], &col[2][z]}, {&col[1][z], &col[2][y]}}, {1.0, -1.0});
+    }
+    jac = product_sum({{&col[0][0], &w[0]}, {&col[0][1], &w[1]}, {&col[0][2], &w[2]}}, {1.0, 1.0, 1.0});
+    n = product_sum({{&jac, &jac}}, {1.0});
+  } else if (dim == 2) {
+    std::array<Poly, 3> w;  // c_0 x c_1
+    for (std::size_t x = 0; x < 3; ++x) {
+      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
+      w[x] = product_sum({{&col[0][y], &col[1][z]}, {&col[0][z], &col[1][y]}}, {1.0, -1.0});
+    }
+    jac = linear_sum({&w[0], &w[1], &w[2]}, {ref[0], ref[1], ref[2]});
+    n = area ? product_sum({{&w[0], &w[0]}, {&w[1], &w[1]}, {&w[2], &w[2]}}, {1.0, 1.0, 1.0})
+             : product_sum({{&jac, &jac}}, {1.0});
+  } else {
+    jac = linear_sum({&col[0][0], &col[0][1], &col[0][2]}, {ref[0], ref[1], ref[2]});
+    n = product_sum({{&jac, &jac}}, {1.0});
+  }
+  // J in the squared space (J * 1, 1 with all coefficients 1 in J's space), for the sign
+  // tests of the subdomains; not needed when J > 0 is proven on the whole element.
+  Poly jsq;
+  if (v == Validity::valid) {
+    jsq.deg = space.squared_degrees();
+    jsq.c.assign(s2, 1.0);
+    jsq.b = {1, 0};
+  } else {
+    Poly one;
+    one.deg = jac.deg;
+    one.c.assign(jac.c.size(), 1.0);
+    one.b = {1, 0};
+    jsq = product_sum({{&jac, &one}}, {1.0});
+  }
+  std::vector<Poly> dk(frames);
+  for (std::size_t f = 0; f < frames; ++f) {
+    const Frame& fr = space.frames()[f];
+    Poly prod;
+    for (std::size_t j = 0; j < udim; ++j) {
+      std::array<Poly, 3> v;
+      for (std::size_t x = 0; x < 3; ++x) {
+        std::vector<const Poly*> q;
+        std::vector<double> w;
+        for (std::size_t c = 0; c < udim; ++c)
+          if (fr[j][c] != 0) {
+            q.push_back(&col[c][x]);
+            w.push_back(fr[j][c]);
+          }
+        v[x] = linear_sum(q, w);
+      }
+      Poly sq = product_sum({{&v[0], &v[0]}, {&v[1], &v[1]}, {&v[2], &v[2]}}, {1.0, 1.0, 1.0});
+      prod = j == 0 ? std::move(sq) : product_sum({{&prod, &sq}}, {1.0});
+    }
+    dk[f] = std::move(prod);
+  }
+
+  // 3. The root: vectors J, N, D_k in the squared space, slot 0 of the leaf pool.
+  const std::size_t stride = nvec * s2;
+  ws.work.resize(2 * s2);
+  ws.pool.assign(stride, 0.0);
+  ws.pool_err.assign(nvec, 0.0);
+  const std::array<const Poly*, 2> jn = {&jsq, &n};
+  for (std::size_t q = 0; q < nvec; ++q) {
+    const Poly& p = q < 2 ? *jn[q] : dk[q - 2];
+    QV_ASSERT(p.c.size() == s2 && p.deg.size() == space.squared_degrees().size(), "squared space");
+    for (std::size_t f = 0; f < p.deg.size(); ++f)
+      QV_ASSERT(p.deg[f].degree == space.squared_degrees()[f].degree, "squared degree");
+    std::copy(p.c.begin(), p.c.end(), ws.pool.begin() + static_cast<std::ptrdiff_t>(q * s2));
+    ws.pool_err[q] = next_up(p.b.e * 1.01);  // 1% covers the rounding of these bounds
+  }
+  ws.free_slots.clear();
+  ws.heap.clear();
+  // valid lets every subdomain skip its own sign test (the J vector is then a
+  // placeholder); invalid means a point with J <= 0, where sj <= 0.
+  Bounder bounder(space, s2, v == Validity::valid);
+  double upper = v == Validity::invalid ? 0.0 : space.s_hi();
+
+  const double tol = options.abs_tol;
+  const auto cmp = [](const Leaf& a, const Leaf& b) { return a.lower != b.lower ? a.lower > b.lower : a.id > b.id; };
+  double settled = kInf;  // smallest lower bound of the leaves dropped as good enough
+  long next_id = 0;
+  const auto vertex_upper = [&](const double* v, const double* e) {
+    for (int i : b2.vertex_indices()) upper = std::min(upper, bounder.point_upper(v, e, static_cast<std::size_t>(i)));
+  };
+  // Adds a leaf whose coefficients are at `slot`; frees the slot when it needs no split.
+  const auto push = [&](int slot) {
+    const double* v = ws.pool.data() + static_cast<std::size_t>(slot) * stride;
+    const double* e = ws.pool_err.data() + static_cast<std::size_t>(slot) * nvec;
+    vertex_upper(v, e);
+    const double lo = bounder.lower(v, e);
+    if (up(upper - lo) <= tol) {
+      settled = std::min(settled, lo);  // stays good enough: upper only decreases
+      ws.free_slots.push_back(slot);
+      return;
+    }
+    ws.heap.push_back({lo, slot, next_id++});
+    std::push_heap(ws.heap.begin(), ws.heap.end(), cmp);
+  };
+  push(0);
+
+  QualityBounds out;
+  std::vector<double> child(stride), child_err(nvec);
+  while (!ws.heap.empty()) {
+    const Leaf top = ws.heap.front();
+    if (up(upper - std::min(top.lower, settled)) <= tol) break;
+    if (out.subdivisions >= options.max_subdivisions) break;
+    std::pop_heap(ws.heap.begin(), ws.heap.end(), cmp);
+    ws.heap.pop_back();
+    ++out.subdivisions;
+    ws.free_slots.push_back(top.slot);
+    const std::size_t parent_off = static_cast<std::size_t>(top.slot) * stride;
+    const std::vector<double> parent(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
+                                     ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
+    const std::vector<double> parent_err(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
+                                         ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
+    for (int q = 0; q < b2.num_children(); ++q) {
+      for (std::size_t v = 0; v < nvec; ++v) {
+        const double* p = parent.data() + v * s2;
+        b2.subdivide(q, p, child.data() + v * s2, ws.work.data());
+        child_err[v] = up((parent_err[v] + b2.subdivision_rounding() * max_abs(p, s2)) * (1 + 1e-12));
+      }
+      int slot;
+      if (!ws.free_slots.empty()) {
+        slot = ws.free_slots.back();
+        ws.free_slots.pop_back();
+      } else {
+        slot = static_cast<int>(ws.pool_err.size() / nvec);
+        ws.pool.resize(ws.pool.size() + stride);
+        ws.pool_err.resize(ws.pool_err.size() + nvec);
+      }
+      std::copy(child.begin(), child.end(), ws.pool.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(slot) * stride));
+      std::copy(child_err.begin(), child_err.end(), ws.pool_err.begin() + slot * static_cast<std::ptrdiff_t>(nvec));
+      push(slot);
+    }
+  }
+  double lower = settled;
+  for (const Leaf& l : ws.heap) lower = std::min(lower, l.lower);
+  out.lower = lower;
+  out.upper = upper;
+  out.tolerance_met = up(out.upper - out.lower) <= tol;
+  return out;
+}
+
+}  // namespace quadval

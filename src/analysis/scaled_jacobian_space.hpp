@@ -1,0 +1,70 @@
+#pragma once
+// Per-type data of the scaled-Jacobian bounds (scaled_jacobian.hpp): the exact linear maps
+// from an element's nodes to the Bézier coefficients of the columns of J_p in their own
+// (native) degrees, the Bézier space of the squared quantities N and D_k (the Jacobian
+// space's factors at twice their degree), the frames and the normalisation. Built once
+// per type, immutable, shared by all threads. Internal to src/analysis.
+#include <array>
+#include <span>
+#include <vector>
+
+#include "analysis/jacobian_space.hpp"
+#include "quadval/bezier_basis.hpp"
+#include "quadval/element_type.hpp"
+#include "quadval/jacobian_bounds.hpp"
+#include "quadval/quality_bounds.hpp"
+
+namespace quadval {
+
+/// Frame column j = sum_c coefficient[j][c] * (column c of J_p); entries in {-1, 0, 1}.
+using Frame = std::array<std::array<int, 3>, 3>;
+
+class ScaledJacobianSpace {
+ public:
+  /// @pre scaled_jacobian_supported(type)
+  explicit ScaledJacobianSpace(const ElementType& type);
+
+  const ElementType& type() const noexcept { return *type_; }
+  int dim() const noexcept { return type_->dim; }
+  /// The space of J (jacobian_factor_degrees) and of N, D_k (twice those degrees).
+  const std::vector<FactorDegree>& j_degrees() const noexcept { return j_degrees_; }
+  const std::vector<FactorDegree>& squared_degrees() const noexcept { return squared_degrees_; }
+  const BezierBasis& squared() const noexcept { return squared_; }
+  const std::vector<Frame>& frames() const noexcept { return frames_; }
+  /// s of the definition and a guaranteed enclosure s_lo <= s <= s_hi.
+  double s_lo() const noexcept { return s_lo_; }
+  double s_hi() const noexcept { return s_hi_; }
+
+  /// Column c = dX/dxi_c (Gmsh coordinates) lies in the tensor space column_degrees(c):
+  /// the geometry's degree p per factor, p - 1 in the factor holding direction c.
+  const std::vector<FactorDegree>& column_degrees(int c) const noexcept { return col_degrees_[static_cast<std::size_t>(c)]; }
+  int column_size(int c) const noexcept { return col_size_[static_cast<std::size_t>(c)]; }
+  /// Its Bézier coefficients = column_map(c) * (x_i - x_0) per axis: row-major
+  /// column_size(c) x #nodes, each entry within 2u relative of the exact rational
+  /// (computed once in exact arithmetic from the exact shape-function gradients).
+  const std::vector<double>& column_map(int c) const noexcept { return col_map_[static_cast<std::size_t>(c)]; }
+  /// max over rows of sum_i |exact entry|, rounded up.
+  double column_row_sum(int c) const noexcept { return col_row_sum_[static_cast<std::size_t>(c)]; }
+
+ private:
+  const ElementType* type_;
+  std::vector<FactorDegree> j_degrees_, squared_degrees_;
+  BezierBasis squared_;
+  std::vector<Frame> frames_;
+  std::array<std::vector<FactorDegree>, 3> col_degrees_;
+  std::array<int, 3> col_size_{0, 0, 0};
+  std::array<std::vector<double>, 3> col_map_;
+  std::array<double, 3> col_row_sum_{0, 0, 0};
+  double s_lo_ = 1, s_hi_ = 1;
+};
+
+/// The shared space of `type`; thread-safe, built once. @pre scaled_jacobian_supported(type)
+const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type);
+
+/// scaled_jacobian_bounds with the element's validity already settled by the Jacobian
+/// engine (jacobian_bounds, any goal: only the sign of min J is used), as check_mesh has
+/// it; results are identical. @pre v is that element's certified validity.
+QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
+                                           const QualityOptions& options, bool planar, Validity v);
+
+}  // namespace quadval

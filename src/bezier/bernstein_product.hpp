@@ -1,0 +1,96 @@
+#pragma once
+// Products of polynomials in tensor-product Bernstein form (thesis, Paper V Prop. 4 and
+// its three-factor form of §5.1), for any tensor product of simplex factors with the
+// BezierBasis layout (coefficient index i_0 + s_0 * (i_1 + s_1 * i_2), factor 0 fastest;
+// multi-indices in BernsteinSimplex order). Internal to quadval (src/).
+//
+// Per factor, the coefficient of B^{nu+mu}_k in f g is
+//   h_k = sum_{i + j = k} f_i g_j alpha_i^nu alpha_j^mu / alpha_k^{nu+mu},
+// alpha the multinomial of the multi-index; the weights of one k are positive and sum to 1
+// (Vandermonde's identity), so every coefficient of a product is a convex combination of
+// products f_i g_j. Rounding: each weight is rounded to nearest (relative u), the tensor
+// weight is a product of at most three (2 more roundings), times scale, times f_i g_j
+// (2 more) and summed with the other terms: |computed - exact| <= rounding(k) * sum over
+// the k accumulated products of |scale| max|f| max|g|  (Higham, §3.1). The product is
+// computed as the equivalent scaled convolution (at most 16 roundings per term).
+#include <array>
+#include <span>
+#include <vector>
+
+#include "quadval/bezier_basis.hpp"
+
+namespace quadval {
+
+/// Multi-indices of the Bernstein polynomials of degree n on the d-simplex, in the order
+/// of BernsteinSimplex::multi_indices() (without building the factor's matrices).
+std::vector<std::array<int, 4>> simplex_multi_indices(int dim, int degree);
+
+/// Number of coefficients of a tensor-product space: prod C(n_f + d_f, d_f).
+int bernstein_space_size(std::span<const FactorDegree> factors) noexcept;
+
+/// Degrees of the space of a product: n_f + m_f per factor. @pre same factor dims
+std::vector<FactorDegree> product_degrees(std::span<const FactorDegree> f,
+                                          std::span<const FactorDegree> g);
+
+/// The product table of two spaces with the same factor dimensions; immutable, shared.
+class BernsteinProduct {
+ public:
+  /// @pre f.size() == g.size() in 1..3, f[i].dim == g[i].dim, degrees >= 0
+  BernsteinProduct(std::vector<FactorDegree> f, std::vector<FactorDegree> g);
+
+  int f_size() const noexcept { return f_size_; }
+  int g_size() const noexcept { return g_size_; }
+  int h_size() const noexcept { return h_size_; }
+  std::span<const FactorDegree> h_degrees() const noexcept { return h_degrees_; }
+  /// Largest number of (i, j) pairs that contribute to one output coefficient.
+  int max_terms() const noexcept { return max_terms_; }
+
+  /// h += scale * f * g (coefficient vectors of sizes f_size(), g_size(), h_size()).
+  void multiply_add(const double* f, const double* g, double scale, double* h) const;
+  /// h = f * g.
+  void multiply(const double* f, const double* g, double* h) const;
+  /// Choose the per-factor weighted-entry loop (default for small products) or the scaled
+  /// convolution (default for large ones); same product within rounding().
+  void use_entry_kernel(bool on) noexcept { entries_kernel_ = on; }
+
+  /// Relative rounding bound of `products` products accumulated into one h (starting from
+  /// zero): |h - exact| <= rounding(products) * sum |scale| max|f| max|g|.
+  double rounding(int products) const noexcept;
+
+ private:
+  struct Entry {
+    int i, j, k;  // factor-local indices in f, g, h
+    double w;     // alpha_i alpha_j / alpha_k, rounded to nearest
+  };
+  std::vector<FactorDegree> f_degrees_, g_degrees_, h_degrees_;
+  int f_size_ = 1, g_size_ = 1, h_size_ = 1;
+  int max_terms_ = 1;
+  std::array<int, 3> f_stride_{}, g_stride_{}, h_stride_{};
+  std::vector<Entry> entries_[3];  // per factor; unused factors hold one entry {0,0,0,1}
+  // The same product as a dense convolution: coefficients scaled by their multinomials on
+  // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
+  // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k.
+  struct Grid {
+    std::array<int, 3> dims{1, 1, 1};
+    std::vector<int> cell;       // grid cell of each coefficient
+    std::vector<double> scale;   // alpha (f, g) or 1 / alpha (h) per coefficient, rounded
+    std::vector<int> row_len;    // per row (coordinates 1, 2): valid cells along coordinate 0
+    std::vector<std::array<int, 3>> rows;  // the non-empty rows: (coordinate 1, 2, length)
+  };
+  Grid f_grid_, g_grid_, h_grid_;
+  bool entries_kernel_ = false;  // the weighted-entry loop (small products)
+  void multiply_add_grid(const double* f, const double* g, double scale, double* h) const;
+};
+
+/// The shared table of (f, g); thread-safe, built once per key.
+const BernsteinProduct& bernstein_product(std::span<const FactorDegree> f,
+                                          std::span<const FactorDegree> g);
+
+/// out = f * g * k (three factors of §5.1, as (f g) k), scratch sized for f * g.
+/// @return the relative rounding bound: |out - exact| <= returned * max|f| max|g| max|k|
+double bernstein_triple_product(std::span<const FactorDegree> f_deg, const double* f,
+                                std::span<const FactorDegree> g_deg, const double* g,
+                                std::span<const FactorDegree> k_deg, const double* k,
+                                std::vector<double>& scratch, double* out);
+
+}  // namespace quadval
