@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Side by side: `quadval recombine` (Blossom-Quad with LEMON) and Gmsh 4.8.4's Blossom
+"""Side by side: `quadval recombine` (Blossom-Quad, exact matching by
+src/recombine/blossom_solver.cpp) and Gmsh 4.8.4's Blossom
 recombination (Mesh.RecombinationAlgorithm = 1, default Mesh.Smoothing and topology
 optimisation) on the same triangle meshes. Prints one row per tool and mesh: quads, triangles
 left, eta_min, eta_mean, % interior vertices of degree 4, time (median of --runs), peak memory.

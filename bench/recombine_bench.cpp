@@ -1,9 +1,9 @@
-// Recombination benchmarks on jittered grids of n triangles: the dual graph, the LEMON
-// matching, and the whole pipeline (the end-to-end figure with I/O is measured by
-// bench/compare_gmsh_recombine.py). The matching is also timed on a jittered equilateral
+// Recombination benchmarks on jittered grids of n triangles: the dual graph, the exact
+// matching (blossom_solver.hpp), and the whole pipeline (the end-to-end figure with I/O is
+// measured by bench/compare_gmsh_recombine.py). The matching is also timed on a jittered equilateral
 // lattice: near-equilateral triangles (as Frontal-Delaunay makes) give nearly equal pair costs,
-// LEMON's hard case (its fractional warm start grows superlinearly there: ~n^2 measured),
-// which the right-triangle grid with its spread of costs hides.
+// the hard case of blossom algorithms (LEMON's fractional warm start and our alternating trees
+// both grow superlinearly there), which the right-triangle grid with its spread of costs hides.
 //
 //   build/bench/quadval_bench --benchmark_filter=Recombine
 #include <cmath>

@@ -7,9 +7,14 @@
 ///   1. triangles in (odd counts handled as documented in RecombineOptions::odd_policy);
 ///   2. dual graph with pair costs 1 - eta (eq. 3, 4) or the cross-field cost (eq. 7);
 ///   3. extra boundary edges of cost 1000 (§5.3);
-///   4. min-cost perfect matching (LEMON's MaxWeightedPerfectMatching, int64 weights);
+///   4. min-cost perfect matching, exact on int64 costs (src/recombine/blossom_solver.hpp: a
+///      primal-dual blossom solver with a greedy start, checked against LEMON's
+///      MaxWeightedPerfectMatching and brute force in the tests; LEMON finds the maximum
+///      matching when no perfect one exists);
 ///   5. repair of matched extra edges: edge swap (Fig. 8) or vertex duplication (Fig. 9);
-///   6. smoothing, quad-vertex-merge (Fig. 10), doublet collapse (Fig. 11).
+///   6. smoothing (boundary nodes slide along straight boundary segments), quad-vertex-merge
+///      (Fig. 10), doublet collapse (Fig. 11), then a local search on the worst 2 % of the
+///      nodes that only accepts moves raising the worst quality there.
 
 #include <cstddef>
 #include <functional>

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numeric>
 
-
+#include "blossom_solver.hpp"
 #include "lemon_matching.hpp"
 #include "quadval/error.hpp"
 
@@ -29,18 +29,21 @@ Matching read_matching(const DualGraph& g, const std::vector<char>& matched) {
 
 Matching blossom_matching(const DualGraph& g) {
   QV_ASSERT(g.num_triangles < (1u << 30), g.num_triangles << " triangles");
+  std::vector<char> matched;
+  if (g.num_triangles % 2 == 0) {
+    std::vector<CostEdge> costs(g.pairs.size());
+    for (std::uint32_t i = 0; i < g.pairs.size(); ++i)
+      costs[i] = {g.pairs[i].t0, g.pairs[i].t1, -matching_weight(g.pairs[i].cost)};
+    if (min_cost_perfect_matching(g.num_triangles, costs, matched)) {
+      Matching m = read_matching(g, matched);
+      QV_ASSERT(m.perfect, "a perfect matching with " << m.pairs.size() << " pairs for "
+                                                      << g.num_triangles);
+      return m;
+    }
+  }
   std::vector<WeightedEdge> edges(g.pairs.size());
   for (std::uint32_t i = 0; i < g.pairs.size(); ++i)
-    edges[i] = {g.pairs[i].t0, g.pairs[i].t1, matching_weight(g.pairs[i].cost)};
-  std::vector<char> matched;
-  if (g.num_triangles % 2 == 0 &&
-      lemon_max_weight_perfect_matching(g.num_triangles, edges, matched)) {
-    Matching m = read_matching(g, matched);
-    QV_ASSERT(m.perfect, "LEMON reported a perfect matching with " << m.pairs.size()
-                                                                   << " pairs for "
-                                                                   << g.num_triangles);
-    return m;
-  }
+    edges[i] = {g.pairs[i].t0, g.pairs[i].t1, 0};
   // No perfect matching: every weight positive, so that more pairs weigh more; then quality.
   double max_cost = 0;
   for (const TrianglePair& p : g.pairs) max_cost = std::max(max_cost, p.cost);

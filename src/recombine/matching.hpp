@@ -1,5 +1,6 @@
 #pragma once
-// Matchings of the dual graph: optimal (LEMON's weighted perfect matching) and greedy.
+// Matchings of the dual graph: optimal (our Blossom V-style solver, blossom_solver.hpp) and
+// greedy.
 
 #include <cstdint>
 #include <vector>
@@ -16,15 +17,15 @@ struct Matching {
   double cost = 0.0;                 ///< sum of the pair costs
 };
 
-/// Cost -> LEMON weight: w = -round(1e9 * cost), in 64-bit integers (int weights overflow
-/// silently at the extra-edge cost and give a wrong "perfect" matching: measured).
+/// Cost -> integer weight: w = -round(1e9 * cost), in 64-bit integers (LEMON's default int
+/// weights overflow silently at the extra-edge cost and give a wrong "perfect" matching).
 long long matching_weight(double cost) noexcept;
 
-/// Minimum-cost perfect matching (Paper I §4, eq. 4) by LEMON's MaxWeightedPerfectMatching
-/// on the negated integer weights. If no perfect matching exists, falls back to LEMON's
-/// MaxWeightedMatching with weights 2 (1 + max cost) - cost, which leaves some triangles
-/// unmatched (perfect = false; the number left is small but not proven minimal).
-/// Costs are optimal to within 1e-9 per pair (the weight rounding).
+/// Minimum-cost perfect matching (Paper I §4, eq. 4) of the integer costs -matching_weight
+/// by min_cost_perfect_matching (exact on those integers). If no perfect matching exists,
+/// falls back to LEMON's MaxWeightedMatching with weights 2 (1 + max cost) - cost, which
+/// leaves some triangles unmatched (perfect = false; the number left is small but not proven
+/// minimal). Costs are optimal to within 1e-9 per pair (the weight rounding).
 Matching blossom_matching(const DualGraph& g);
 
 /// Greedy matching of Paper I §3: pairs by increasing cost (ties: lower pair index), taken

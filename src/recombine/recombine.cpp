@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "boundary_slide.hpp"
 #include "dual_graph.hpp"
 #include "lookahead_matching.hpp"
 #include "lookahead_parity.hpp"
@@ -97,12 +98,16 @@ MixedMesh mesh_from_matching(const TriangleSurface& s, const DualGraph& g, const
 void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& options,
               RecombineStats& stats, StageTimer& timer) {
   const std::vector<char> fixed = region_boundary_nodes(m);
+  const auto slides = straight_boundary_slides(m, fixed);
   SmoothingOptions smoothing{options.smoothing_passes,
-                             options.size_field ? &options.size_field : nullptr, !s.planar};
+                             options.size_field ? &options.size_field : nullptr, !s.planar,
+                             &slides};
   stats.smoothing_moves += smooth(m, fixed, smoothing);
   timer.stage("smooth", fmt::format("{} passes, {} moves", options.smoothing_passes,
                                     stats.smoothing_moves));
   const CleanupCounts c = cleanup_quads(m, fixed, options.max_cleanup_passes);
+  const auto slides_after = straight_boundary_slides(m, fixed);  // the clean-up edits elements
+  smoothing.slides = &slides_after;
   stats.vertex_merges += c.vertex_merges;
   stats.doublet_collapses += c.doublet_collapses;
   timer.stage("cleanup", fmt::format("{} quad-vertex-merges, {} doublet collapses",
@@ -111,6 +116,11 @@ void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& op
     const std::size_t moves = smooth(m, fixed, smoothing);
     stats.smoothing_moves += moves;
     timer.stage("smooth", fmt::format("{} moves after clean-up", moves));
+  }
+  if (options.smoothing_passes > 0) {
+    const std::size_t moves = polish_worst(m, fixed, smoothing);
+    stats.smoothing_moves += moves;
+    timer.stage("polish", fmt::format("{} moves at the worst elements", moves));
   }
 }
 

@@ -18,9 +18,12 @@ struct SmoothingOptions {
   const SizeFunction* size_field = nullptr;
   /// Project the move on the tangent plane (the mean of the element normals): for surfaces.
   bool tangential = false;
+  /// Optional, per node (straight_boundary_slides): a fixed node with neighbours {a, b} moves
+  /// along the line a-b instead, and only to points strictly between a and b.
+  const std::vector<std::array<NodeIndex, 2>>* slides = nullptr;
 };
 
-/// Smooths the free nodes (fixed[v] == 0) in place. Returns the number of accepted moves.
+/// Smooths the free nodes (fixed[v] == 0, and the fixed ones that may slide) in place. Returns the number of accepted moves.
 /// A move to the weighted mean is tried, then half of it. Two phases of `passes` sweeps each:
 /// 1. a move is kept when min(score of the elements at v) does not decrease (element_score:
 ///    > 0 valid), which raises the worst element of the mesh;
@@ -29,5 +32,14 @@ struct SmoothingOptions {
 ///    and eta_mean rises; measured on rect-sin-a6: mean 0.740 -> 0.763, min kept).
 /// No move can invalidate a valid element.
 std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options);
+
+/// A last pass on the worst elements (the worst `share` of them, at least 16): each of their
+/// movable nodes (as in smooth) does a pattern search, steps of +-h along two tangent
+/// directions (or along its straight side), h halving from a tenth of its mean edge length
+/// down to 1e-3 of it; a step is kept only when it strictly raises the worst score of the
+/// elements at the node. So the mesh's worst element never gets worse and no element is
+/// inverted (Paper I §6 asks for no inversion; the max-min search is ours). Returns moves kept.
+std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,
+                         const SmoothingOptions& options, double share = 0.02);
 
 }  // namespace quadval::recombine_detail

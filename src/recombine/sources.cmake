@@ -2,10 +2,12 @@ list(APPEND QUADVAL_SOURCES
   src/recombine/quad_quality.cpp
   src/recombine/triangle_input.cpp
   src/recombine/dual_graph.cpp
+  src/recombine/blossom_solver.cpp
   src/recombine/matching.cpp
   src/recombine/mixed_mesh.cpp
   src/recombine/repair.cpp
   src/recombine/smoothing.cpp
+  src/recombine/boundary_slide.cpp
   src/recombine/quad_cleanup.cpp
   src/recombine/refine.cpp
   src/recombine/recombine_stats.cpp

@@ -1,6 +1,9 @@
 list(APPEND QUADVAL_TEST_SOURCES
   recombine/quad_quality_test.cpp
   recombine/blossom_optimality_test.cpp
+  recombine/blossom_solver_test.cpp
+  recombine/boundary_slide_test.cpp
+  recombine/smoothing_test.cpp
   recombine/recombine_test.cpp
   recombine/repair_test.cpp
   recombine/recombine_input_test.cpp

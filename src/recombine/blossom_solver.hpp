@@ -1,0 +1,38 @@
+#pragma once
+// Minimum-cost perfect matching by Edmonds' blossom algorithm, organised as in Blossom V
+// (Kolmogorov 2009, "Blossom V: a new implementation of a minimum cost perfect matching
+// algorithm"): a greedy initialisation of the duals and the matching, then alternating trees
+// from all free vertices growing together, the dual change applied lazily (one running offset)
+// and the events (grow, shrink, augment, expand) taken from priority queues. Exact: integer
+// costs, doubled inside so that every dual stays an integer.
+//
+// Measured against LEMON's MaxWeightedPerfectMatching (kept as the test oracle, and for the
+// non-perfect fallback): equal optimum everywhere tested; about as fast (102k uniform
+// Frontal-Delaunay triangles: 8.8 s vs 8.1 s CPU; 35k graded: 0.17 vs 0.27 s end to end).
+// Both are slow where nearly all pair costs are equal: the alternating trees there grow over
+// most of the mesh before they meet. Blossom V's variable per-tree dual steps and per-node
+// edge lists are the known remedy and are not done here.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace quadval::recombine_detail {
+
+struct CostEdge {
+  std::uint32_t u, v;  ///< u != v, both < num_nodes; parallel edges are allowed
+  std::int64_t cost;   ///< |cost| <= kMaxMatchingCost
+};
+
+/// Bound on |cost|: leaves int64 headroom (2^16) over the doubled costs for the duals, their
+/// per-tree offsets and the event keys, which are sums of a few such values.
+inline constexpr std::int64_t kMaxMatchingCost = std::int64_t{1} << 46;
+
+/// Minimum-cost perfect matching of the graph (num_nodes, edges).
+/// @param[out] matched  #edges flags, 1 for the edges of the matching (resized here)
+/// @return false when the graph has no perfect matching (`matched` is then unspecified)
+/// @pre every edge has u != v, u, v < num_nodes, |cost| <= kMaxMatchingCost (QV_ASSERT)
+bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
+                               std::vector<char>& matched);
+
+}  // namespace quadval::recombine_detail
