@@ -51,7 +51,11 @@ double ratio_lower_bound(const std::vector<double>& n, double en, const std::vec
   return lower <= upper ? upper : -kInf;
 }
 
+thread_local bool use_filter = true;
+
 }  // namespace
+
+void mu_use_filter(bool on) noexcept { use_filter = on; }
 
 void MuMetric::product(const BernsteinProduct& table,
                        std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms,
@@ -155,22 +159,41 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
   const BernsteinProduct& p66 = space.prod(6, 6);
   const BernsteinProduct& p44 = space.prod(4, 4);
   const BernsteinProduct& p84 = space.prod(8, 4);
+  // e3 = det D, q^3 and q p^2 (degree 6n): A, for the filter and the (q, p^2, e3) form.
+  product(p22, {{1.0, &d_[0], &d_[1]}}, de_[0]);
+  product(p22, {{1.0, &m_[3], &m_[4]}}, de_[1]);
+  product(p22, {{1.0, &m_[5], &m_[5]}}, de_[2]);
+  product(p22, {{1.0, &m_[4], &m_[4]}}, de_[3]);
+  product(p22, {{1.0, &m_[3], &m_[3]}}, de_[4]);
+  product(p42, {{1.0, &de_[0], &d_[2]}, {2.0, &de_[1], &m_[5]}, {-1.0, &de_[2], &d_[0]},
+                {-1.0, &de_[3], &d_[1]}, {-1.0, &de_[4], &d_[2]}},
+          e3_);
+  product(p42, {{1.0, &q2_, &q_}}, q3_);
+  product(space.prod(2, 4), {{1.0, &q_, &p2_}}, qp2_);
+  // Degree-6n filter (soundness proof at certify_filter): the largest r it certifies is
+  // a true lower bound; most subdomains stop here, before any degree-12n product.
+  if (use_filter) {
+    make_p_upper();
+    product(p22, {{1.0, &pu_, &pu_}}, pu2_);
+    product(p42, {{1.0, &pu2_, &pu_}}, pu3_);
+    const double first = std::min(r_hi - 0.5 * tol_r, r_target);
+    if (first > lo && first < 1) {
+      if (certify_filter(first)) return first;
+      double f_lo = lo, f_hi = first;
+      for (int it = 0; it < 60 && f_hi - f_lo > 0.25 * tol_r; ++it) {
+        const double mid = 0.5 * (f_lo + f_hi);
+        (certify_filter(mid) ? f_lo : f_hi) = mid;
+      }
+      lo = f_lo;
+      if (!(r_hi - lo > tol_r)) return lo;
+    }
+  }
   // Two exact forms of A and Pi_r: in (q, p^2, e3 = det D), whose terms are of the size of
   // the result near the ideal element (R near 1), and in the invariants of M
   // (I1 = tr M, I2 = sum of principal 2x2 minors, I3 = det M), whose terms are of the size
   // of the result near degeneracy (R near 0). The subdomain's upper bound picks one.
   invariant_form_ = r_hi < 0.25;
   if (!invariant_form_) {
-    product(p22, {{1.0, &d_[0], &d_[1]}}, de_[0]);
-    product(p22, {{1.0, &m_[3], &m_[4]}}, de_[1]);
-    product(p22, {{1.0, &m_[5], &m_[5]}}, de_[2]);
-    product(p22, {{1.0, &m_[4], &m_[4]}}, de_[3]);
-    product(p22, {{1.0, &m_[3], &m_[3]}}, de_[4]);
-    product(p42, {{1.0, &de_[0], &d_[2]}, {2.0, &de_[1], &m_[5]}, {-1.0, &de_[2], &d_[0]},
-                  {-1.0, &de_[3], &d_[1]}, {-1.0, &de_[4], &d_[2]}},
-            e3_);
-    product(p42, {{1.0, &q2_, &q_}}, q3_);
-    product(space.prod(2, 4), {{1.0, &q_, &p2_}}, qp2_);
     product(p44, {{1.0, &p2_, &p2_}}, p4_);
     product(p84, {{1.0, &p4_, &p2_}}, big_[3]);
     product(p66, {{1.0, &e3_, &e3_}}, big_[6]);
@@ -227,6 +250,68 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
     (certify_3d(mid) ? lo : hi) = mid;
   }
   return lo;
+}
+
+void MuMetric::make_p_upper() {
+  // p^2 = |V|^2 / 6 pointwise, V = (d0, d1, d2, sqrt2 m01, sqrt2 m02, sqrt2 m12) (degree 2n).
+  // With V_i the exact control values of V, V(x) = sum_i B_i(x) V_i (B_i >= 0, sum 1), so
+  // by the triangle inequality p(x) = |V(x)| / sqrt 6 <= sum_i B_i(x) |V_i| / sqrt 6:
+  // the polynomial P with control values P_i >= |V_i| / sqrt 6 satisfies P >= p >= 0
+  // (Paper V Lemma 6, here as a pointwise polynomial bound). P_i is formed from
+  // |V_ki| <= |computed| + err, the sum inflated by 1e-13 (its ~12 roundings) and the
+  // square root rounded up; P's control values are then exact by definition (err 0).
+  const std::size_t n = d_[0].c.size();
+  pu_.c.resize(n);
+  const Poly* comp[6] = {&d_[0], &d_[1], &d_[2], &m_[3], &m_[4], &m_[5]};
+  for (std::size_t i = 0; i < n; ++i) {
+    double sum = 0;
+    for (int k = 0; k < 6; ++k) {
+      const double v = std::abs(comp[k]->c[i]) + comp[k]->err;
+      sum += (k < 3 ? 1.0 : 2.0) * v * v;
+    }
+    pu_.c[i] = next_up(std::sqrt(sum * (1 + 1e-13) / 6));
+  }
+  pu_.err = 0;
+  pu_.mag = max_abs(pu_.c);
+}
+
+bool MuMetric::certify_filter(double r) {
+  // Sufficient condition for R >= r of degree 6n. X^2 = (27/4) r^2 (r+1)^2 (4 p^6 - e3^2)
+  // (mu_metric.hpp), and pointwise |e3| <= 2 p^3 (e3 = 2 p^3 cos 3theta, Paper V App. A).
+  // With P >= p >= 0 (make_p_upper): a = 2 P^3 - e3 >= 0, b = 2 P^3 + e3 >= 0 and
+  // 4 p^6 - e3^2 = (2p^3 - e3)(2p^3 + e3) <= a b. For any constant lambda > 0,
+  // sqrt(a b) <= (lambda a + b / lambda) / 2 (AM-GM), so with k = sqrt(27) r (r+1) / 4
+  //   X <= k (lambda a + b / lambda) = 2k (lambda + 1/lambda) P^3 + k (1/lambda - lambda) e3.
+  // If A - (that) >= 0 everywhere then A >= X >= 0, A^2 >= X^2, Pi_r >= 0, hence R >= r
+  // (exact equivalence of mu_metric.hpp). The polynomial is certified from its control
+  // values (Prop. 5). The bound is pointwise exact where P = p and lambda = sqrt(b / a),
+  // so lambda is taken there at the control value that binds most.
+  const double s = 1 - r, t = r * r + r + 1, v = (r + 2) * (2 * r + 1);
+  const double a0 = s * s * s, a1 = -3 * t * s, a2 = 0.5 * s * v;
+  const double k = 1.299038105676658 * r * (r + 1);  // sqrt(27) / 4 within 1 ulp
+  const std::size_t na = q3_.c.size();
+  double lambda = 1, worst = kInf;
+  for (std::size_t i = 0; i < na; ++i) {
+    const double a = std::max(2 * pu3_.c[i] - e3_.c[i], 1e-300);
+    const double b = std::max(2 * pu3_.c[i] + e3_.c[i], 1e-300);
+    const double slack = a0 * q3_.c[i] + a1 * qp2_.c[i] + a2 * e3_.c[i] - 2 * k * std::sqrt(a * b);
+    if (slack < worst) worst = slack, lambda = std::sqrt(b / a);
+  }
+  lambda = std::clamp(lambda, 1e-4, 1e4);
+  const double c1 = 2 * k * (lambda + 1 / lambda);
+  const double c2 = k * (1 / lambda - lambda);
+  // Every coefficient within 1e-14 relative of its exact value, except c2 (cancellation in
+  // 1/lambda - lambda): within 1e-14 k (lambda + 1/lambda) absolutely.
+  const double m = std::abs(a0) * q3_.mag + std::abs(a1) * qp2_.mag + std::abs(a2) * e3_.mag +
+                   c1 * pu3_.mag + std::abs(c2) * e3_.mag;
+  const double err = (std::abs(a0) * (q3_.err + 1e-14 * q3_.mag) + std::abs(a1) * (qp2_.err + 1e-14 * qp2_.mag) +
+                      std::abs(a2) * (e3_.err + 1e-14 * e3_.mag) + c1 * (pu3_.err + 1e-14 * pu3_.mag) +
+                      std::abs(c2) * e3_.err + 1e-14 * k * (lambda + 1 / lambda) * e3_.mag +
+                      rounding_gamma(8) * m) * kSlack;
+  for (std::size_t i = 0; i < na; ++i)
+    if (!(a0 * q3_.c[i] + a1 * qp2_.c[i] + a2 * e3_.c[i] - c1 * pu3_.c[i] - c2 * e3_.c[i] >= err))
+      return false;
+  return true;
 }
 
 bool MuMetric::certify_direct(const BernsteinProduct& p66, double r) {

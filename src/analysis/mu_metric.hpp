@@ -39,6 +39,10 @@
 
 namespace quadval {
 
+/// Tests only: switch the degree-6n filter of MuMetric::lower_bound off (on by default) in
+/// the calling thread, to compare its bounds with those of the exact certificate alone.
+void mu_use_filter(bool on) noexcept;
+
 /// Scratch of the per-subdomain bounds; one per thread, reused.
 class MuMetric {
  public:
@@ -63,8 +67,12 @@ class MuMetric {
                std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms, Poly& out);
   bool certify_3d(double r);
   bool certify_direct(const BernsteinProduct& p66, double r);
+  // Degree-6n sufficient test A - sqrt(27) r (r+1) P^3 >= 0, P >= p (make_p_upper).
+  void make_p_upper();
+  bool certify_filter(double r);
 
   Poly a_, w_[9], m_[6], q_, d_[3], s_, t_, q2_, p2_, n2_, de_[5], e3_, q3_, qp2_, q2p2_, p4_, tmp_;
+  Poly pu_, pu2_, pu3_;  // P >= p (degree 2n), P^2, P^3
   // q^6, q^4 p^2, q^2 p^4, p^6, q^3 e3, q p^2 e3, e3^2; or (invariant form)
   // I3^2, I2^3, I1 I2 I3, I1^2 I2^2, I1^3 I3
   Poly big_[7];
