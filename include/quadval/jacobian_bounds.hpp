@@ -15,11 +15,11 @@
 /// (doubles, taken as exact) and the exact shape functions. Then, for every element:
 ///   jmin_lower <= min J <= jmin_upper   and   jmax_lower <= max J <= jmax_upper,
 /// with every floating-point rounding accounted for:
-///   - gradient matrices: exact rationals rounded to double (relative error bound known);
-///   - samples of J: an a priori bound from the node-coordinate range R of the element,
-///     the gradient row sums and the rounding of the dot products and the determinant;
-///   - Lagrange-to-Bézier: the row-sum norm of the exact matrix times the sample error,
-///     plus the rounding of the factor-by-factor products;
+///   - J's Bézier coefficients are Bernstein products (Paper V Prop. 4) of the control
+///     points of the derivatives of the map, which are exact linear maps of the nodes
+///     (computed once per type in rational arithmetic and rounded to double): an a priori
+///     bound from the rounded maps' row sums, the node-coordinate range of the element and
+///     the rounding of the products and sums (src/analysis/jacobian_product.cpp);
 ///   - subdivision: exact dyadic matrices, nonnegative rows summing to 1, so each level
 ///     adds only the rounding of its sums (relative to the largest coefficient);
 ///   - bounds are finally rounded outward (nextafter).
@@ -91,8 +91,9 @@ class BoundsWorkspace {
 };
 
 /// True when jacobian_bounds handles this type: Lagrange lines, triangles, quadrangles,
-/// tetrahedra, prisms, hexahedra (complete and incomplete) up to max_supported_order;
-/// not pyramids (a separate space, Paper IV).
+/// tetrahedra, prisms, hexahedra (complete and incomplete) up to max_supported_order, and
+/// Bergot's pyramids of orders 1 to 9 (Paper IV: the pyramid as a shrunk cube, whose map
+/// is a polynomial in the cube coordinates; src/analysis/pyramid_space.hpp).
 bool jacobian_bounds_supported(const ElementType& type) noexcept;
 
 /// Certified bounds of J for one element.

@@ -110,17 +110,36 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   }
   report.elements.resize(total);
 
-  const int threads = options.threads > 0 ? options.threads : omp_get_max_threads();
+  // Build the shared spaces up front (once per type, outside the parallel region), except
+  // for fast-path types: their space is built (thread-safely) only if an element needs it.
+  // Meanwhile estimate the work: for validity about 1 ns per node x J coefficient of an
+  // element (the derivative maps and products), about 64 ns per fast-path element;
+  // measuring (J range, mu, scaled Jacobian) refines much further: some 50 times that.
+  const double weight = bo.goal == BoundsGoal::measure || want_mu || want_sj ? 50 : 1;
+  double work = 0;
+  for (const ElementBlock& blk : mesh.blocks) {
+    if (blk.type->dim != report.dimension || !jacobian_supported(*blk.type)) continue;
+    const auto count = static_cast<double>(blk.size());
+    if (fast_path && linear_kind(*blk.type, report.planar) != LinearKind::none) {
+      work += 64 * count;
+    } else {
+      const JacobianSpace& space = jacobian_space(*blk.type);
+      work += count * blk.type->num_nodes * space.basis().size();
+    }
+  }
+  work *= weight;
+  // Threads only for work worth them: each extra one costs its wake-up and the closing
+  // barrier, milliseconds when the cores are busy (and results do not depend on it), so
+  // one thread per kWorkPerThread units (about 10 ms), and never more than chunks.
+  constexpr double kWorkPerThread = 1e7;
+  const int requested = options.threads > 0 ? options.threads : omp_get_max_threads();
+  const auto useful = static_cast<std::size_t>(std::max(1.0, std::ceil(work / kWorkPerThread)));
+  const int threads = static_cast<int>(
+      std::max<std::size_t>(1, std::min({static_cast<std::size_t>(requested), chunks.size(), useful})));
   report.threads = threads;
   std::vector<ThreadStats> stats(static_cast<std::size_t>(threads));
   std::atomic<std::size_t> done{0};
   std::exception_ptr failure;
-  // Build the shared spaces up front (once per type, outside the parallel region), except
-  // for fast-path types: their space is built (thread-safely) only if an element needs it.
-  for (const ElementBlock& blk : mesh.blocks)
-    if (blk.type->dim == report.dimension && jacobian_supported(*blk.type) &&
-        !(fast_path && linear_kind(*blk.type, report.planar) != LinearKind::none))
-      (void)jacobian_space(*blk.type);
 
 #pragma omp parallel num_threads(threads)
   {

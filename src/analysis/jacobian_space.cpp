@@ -52,42 +52,52 @@ mpq_class frac(long n, long d) {
   return q;
 }
 
-// Silvester's P_m(l) = prod_{k<m} (p l - k) / (k + 1) and its derivative.
-mpq_class silvester(int p, int m, const mpq_class& l) {
-  mpq_class r = 1;
-  for (int k = 0; k < m; ++k) r *= (p * l - k) / mpq_class(k + 1);
-  return r;
-}
-mpq_class silvester_derivative(int p, int m, const mpq_class& l) {
-  mpq_class sum = 0;
-  for (int j = 0; j < m; ++j) {
-    mpq_class term = frac(p, j + 1);
-    for (int k = 0; k < m; ++k)
-      if (k != j) term *= (p * l - k) / mpq_class(k + 1);
-    sum += term;
+// Silvester's P_m(l) = prod_{k<m} (p l - k) / (k + 1) at l = a / D, in integers:
+// P_m = prod_{k<m} (p a - k D) / (D^m m!) and, since d/dl (p l - j) / (j + 1) = p / (j + 1),
+// P_m' = p sum_j prod_{k<m, k!=j} (p a - k D) / (D^(m-1) m!). Returned: the numerators.
+struct SilvesterNumerators {
+  mpz_class value, deriv;
+};
+SilvesterNumerators silvester_numerators(int p, int m, long a, long den) {
+  SilvesterNumerators r{1, 0};
+  for (int k = 0; k < m; ++k) {
+    const long f = p * a - k * den;
+    r.deriv = r.deriv * f + r.value;  // product rule over the factors so far
+    r.value *= f;
   }
-  return sum;
+  r.deriv *= p;
+  return r;
 }
 
 // Value and local derivatives of the equispaced order-p simplex Lagrange function alpha
-// at barycentric point lambda (d + 1 entries).
-void simplex_lagrange(int d, int p, const MultiIndex& alpha, const std::array<mpq_class, 4>& lambda,
+// at the barycentric point num / den (d + 1 entries): one exact rational per result, over
+// the common denominators D^p prod alpha_a! (value) and D^(p-1) prod alpha_a! (derivatives).
+void simplex_lagrange(int d, int p, const MultiIndex& alpha, const std::array<int, 4>& num, int den,
                       mpq_class& value, std::array<mpq_class, 3>& deriv) {
-  std::array<mpq_class, 4> v, dv;
+  std::array<SilvesterNumerators, 4> f;
+  mpz_class denominator = 1;
   for (int a = 0; a <= d; ++a) {
-    v[a] = silvester(p, alpha[a], lambda[a]);
-    dv[a] = silvester_derivative(p, alpha[a], lambda[a]);
+    const auto as = static_cast<std::size_t>(a);
+    f[as] = silvester_numerators(p, alpha[as], num[as], den);
+    for (int k = 2; k <= alpha[as]; ++k) denominator *= k;
   }
-  value = 1;
-  for (int a = 0; a <= d; ++a) value *= v[a];
   const auto product_except = [&](int skip) {
-    mpq_class r = 1;
+    mpz_class r = 1;
     for (int a = 0; a <= d; ++a)
-      if (a != skip) r *= v[a];
+      if (a != skip) r *= f[static_cast<std::size_t>(a)].value;
     return r;
   };
-  const mpq_class without0 = product_except(0);
-  for (int c = 1; c <= d; ++c) deriv[c - 1] = dv[c] * product_except(c) - dv[0] * without0;
+  mpz_class den_power;
+  mpz_ui_pow_ui(den_power.get_mpz_t(), static_cast<unsigned long>(den), static_cast<unsigned long>(p - 1));
+  const mpz_class deriv_den = den_power * denominator;
+  value = mpq_class(product_except(-1), deriv_den * den);
+  value.canonicalize();
+  const mpz_class without0 = product_except(0);
+  for (int c = 1; c <= d; ++c) {
+    auto& out = deriv[static_cast<std::size_t>(c - 1)];
+    out = mpq_class(f[static_cast<std::size_t>(c)].deriv * product_except(c) - f[0].deriv * without0, deriv_den);
+    out.canonicalize();
+  }
 }
 
 // A Gmsh reference coordinate snapped to the order-p lattice: numerator m of m / p in
@@ -146,12 +156,10 @@ FactorMatrices factor_matrices(const BernsteinSimplex& samples, int p) {
   for (int c = 0; c < d; ++c) m.deriv[c].resize(s * n);
   for (std::size_t k = 0; k < s; ++k) {
     const auto num = samples.point_numerators(static_cast<int>(k));
-    std::array<mpq_class, 4> lambda;
-    for (int a = 0; a <= d; ++a) lambda[static_cast<std::size_t>(a)] = frac(num[static_cast<std::size_t>(a)], samples.point_denominator());
     for (std::size_t i = 0; i < n; ++i) {
       mpq_class v;
       std::array<mpq_class, 3> dv;
-      simplex_lagrange(d, p, m.nodes[i], lambda, v, dv);
+      simplex_lagrange(d, p, m.nodes[i], num, samples.point_denominator(), v, dv);
       m.value[k * n + i] = v;
       for (int c = 0; c < d; ++c) m.deriv[c][k * n + i] = dv[static_cast<std::size_t>(c)];
     }
@@ -308,30 +316,6 @@ JacobianSpace::JacobianSpace(const ElementType& type)
   const auto s = static_cast<std::size_t>(num_samples_);
   const auto n = static_cast<std::size_t>(num_nodes_);
 
-  // Straight-sided element: the order-1 factor bases through the vertices.
-  {
-    std::vector<FactorMatrices> fm;
-    for (std::size_t f = 0; f < shapes.size(); ++f) fm.push_back(factor_matrices(*basis_->factors()[f], 1));
-    const ElementType* linear = find_element_type(type.family, 1, true);
-    const auto idx = node_factor_indices(*linear, 1, reference_nodes(*linear), shapes, fm);
-    std::vector<mpq_class> g[3];
-    tensor_gradients(*basis_, shapes, fm, idx, g);
-    for (int c = 0; c < dim_; ++c) {
-      straight_[c].resize(g[c].size());
-      for (std::size_t i = 0; i < g[c].size(); ++i) straight_[c][i] = nearest(g[c][i]);
-    }
-    straight_rel_error_ = 2 * kUnit;
-    const auto nv = static_cast<std::size_t>(num_vertices_);
-    double r = 0;
-    for (int c = 0; c < dim_; ++c)
-      for (std::size_t k = 0; k < s; ++k) {
-        double row = 0;
-        for (std::size_t v = 0; v < nv; ++v) row += std::abs(straight_[c][k * nv + v]);
-        r = std::max(r, row);
-      }
-    straight_row_sum_ = r * (1 + 4 * straight_rel_error_ + rounding_gamma(num_vertices_));
-  }
-
   double row_sum = 0;
   if (type.complete) {
     // Double entries are products of rounded factor entries: relative error <= 2.5u
@@ -380,6 +364,51 @@ JacobianSpace::JacobianSpace(const ElementType& type)
     }
   // Covers the exact entries (|exact| <= |rounded| (1 + 2 eps)) and the sum's rounding.
   gradient_row_sum_ = row_sum * (1 + 4 * gradient_rel_error_ + rounding_gamma(static_cast<int>(n)));
+}
+
+void JacobianSpace::build_straight() const {
+  std::call_once(straight_once_, [this] {
+    // Pyramids, and orders beyond sampled_max_order, have no sample gradients.
+    if (type_->family == ElementFamily::pyramid || !has_sample_gradients()) return;
+    // The order-1 factor bases through the vertices.
+    const auto shapes = factor_shapes(type_->family);
+    const auto s = static_cast<std::size_t>(num_samples_);
+    std::vector<FactorMatrices> fm;
+    for (std::size_t f = 0; f < shapes.size(); ++f) fm.push_back(factor_matrices(*basis_->factors()[f], 1));
+    const ElementType* linear = find_element_type(type_->family, 1, true);
+    const auto idx = node_factor_indices(*linear, 1, reference_nodes(*linear), shapes, fm);
+    std::vector<mpq_class> g[3];
+    tensor_gradients(*basis_, shapes, fm, idx, g);
+    for (int c = 0; c < dim_; ++c) {
+      straight_[c].resize(g[c].size());
+      for (std::size_t i = 0; i < g[c].size(); ++i) straight_[c][i] = nearest(g[c][i]);
+    }
+    straight_rel_error_ = 2 * kUnit;
+    const auto nv = static_cast<std::size_t>(num_vertices_);
+    double r = 0;
+    for (int c = 0; c < dim_; ++c)
+      for (std::size_t k = 0; k < s; ++k) {
+        double row = 0;
+        for (std::size_t v = 0; v < nv; ++v) row += std::abs(straight_[c][k * nv + v]);
+        r = std::max(r, row);
+      }
+    straight_row_sum_ = r * (1 + 4 * straight_rel_error_ + rounding_gamma(num_vertices_));
+  });
+}
+
+const std::vector<double>& JacobianSpace::straight_gradient(int c) const {
+  build_straight();
+  return straight_[c];
+}
+
+double JacobianSpace::straight_row_sum() const {
+  build_straight();
+  return straight_row_sum_;
+}
+
+double JacobianSpace::straight_rel_error() const {
+  build_straight();
+  return straight_rel_error_;
 }
 
 void JacobianSpace::build_exact() const {

@@ -36,15 +36,16 @@ class JacobianSpace {
   /// gradient_rel_error() * |exact| of the exact rational. c < dim().
   const std::vector<double>& gradient(int c) const noexcept { return grad_[c]; }
   /// Same for the straight-sided (first-order) element through the vertices:
-  /// straight_gradient(c)[k * num_vertices + v], rounded from the exact rationals.
-  const std::vector<double>& straight_gradient(int c) const noexcept { return straight_[c]; }
+  /// straight_gradient(c)[k * num_vertices + v], rounded from the exact rationals. Built
+  /// on first use of any straight_* accessor (thread-safe): only distortion needs it.
+  const std::vector<double>& straight_gradient(int c) const;
   /// max over samples k and directions c of sum_i |gradient(c)[k, i]| (rounded up, and
   /// covering the exact entries too).
   double gradient_row_sum() const noexcept { return gradient_row_sum_; }
   double gradient_rel_error() const noexcept { return gradient_rel_error_; }
   /// The same two constants for straight_gradient.
-  double straight_row_sum() const noexcept { return straight_row_sum_; }
-  double straight_rel_error() const noexcept { return straight_rel_error_; }
+  double straight_row_sum() const;
+  double straight_rel_error() const;
 
   /// The exact gradient matrices (same layout), built on first use; thread-safe.
   /// @pre has_sample_gradients()
@@ -61,6 +62,7 @@ class JacobianSpace {
 
  private:
   void build_exact() const;
+  void build_straight() const;
   void init_pyramid();  // src/analysis/pyramid_space.cpp (Paper IV)
 
   const ElementType* type_;
@@ -70,11 +72,12 @@ class JacobianSpace {
   int dim_ = 0;
   int num_vertices_ = 0;
   std::vector<double> grad_[3];
-  std::vector<double> straight_[3];
+  mutable std::once_flag straight_once_;
+  mutable std::vector<double> straight_[3];
   double gradient_row_sum_ = 0;
   double gradient_rel_error_ = 0;
-  double straight_row_sum_ = 0;
-  double straight_rel_error_ = 0;
+  mutable double straight_row_sum_ = 0;
+  mutable double straight_rel_error_ = 0;
   std::unique_ptr<const JacobianProduct> product_;
   mutable std::once_flag exact_once_;
   mutable std::vector<mpq_class> exact_[3];

@@ -4,6 +4,7 @@
 #include <gmpxx.h>
 
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <memory>
@@ -187,64 +188,95 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
   // Collocation matrix V[k][alpha] = B_alpha(point k) (eq. 18), rounded; T = V^-1 is
   // built on first use (build_to_bezier).
   {
-    const std::vector<mpq_class> v = collocation(dim, alphas_, [this](int k) { return point_numerators(k); },
-                                                 point_denominator());
-    to_lagrange_.resize(v.size());
-    for (std::size_t i = 0; i < v.size(); ++i) to_lagrange_[i] = nearest(v[i]);
+    // Integer arithmetic: B_alpha(beta / m) = mult(alpha) prod beta_a^alpha_a / m^n, one
+    // rational (and one rounding) per nonzero entry: the same doubles as collocation().
+    const mpz_class den_power = [&] {
+      mpz_class r;
+      mpz_ui_pow_ui(r.get_mpz_t(), static_cast<unsigned long>(point_denominator()), static_cast<unsigned long>(degree));
+      return r;
+    }();
+    std::vector<mpz_class> mult(n_sz);
+    for (std::size_t i = 0; i < n_sz; ++i) mult[i] = multinomial(dim, alphas_[i]);
+    to_lagrange_.assign(n_sz * n_sz, 0.0);
+    mpz_class num, power;
+    for (std::size_t k = 0; k < n_sz; ++k) {
+      const MultiIndex beta = point_numerators(static_cast<int>(k));
+      for (std::size_t i = 0; i < n_sz; ++i) {
+        const MultiIndex& alpha = alphas_[i];
+        num = mult[i];
+        for (int a = 0; a <= dim && sgn(num) != 0; ++a) {
+          const auto e = static_cast<unsigned long>(alpha[static_cast<std::size_t>(a)]);
+          if (e == 0) continue;
+          mpz_ui_pow_ui(power.get_mpz_t(), static_cast<unsigned long>(beta[static_cast<std::size_t>(a)]), e);
+          num *= power;
+        }
+        if (sgn(num) == 0) continue;
+        mpq_class q(num, den_power);
+        q.canonicalize();
+        to_lagrange_[k * n_sz + i] = nearest(q);
+      }
+    }
     to_lagrange_t_ = transpose_blocks(to_lagrange_, n_sz);
   }
 
   // Subdivision (eq. 20) by blossoming: the child's coefficient beta is the blossom of the
   // parent at (w_0 repeated beta_0 times, ..., w_d repeated beta_d times), i.e. the
   // coefficient of t^alpha in prod_k (w_k . t)^beta_k times the parent's b_alpha.
-  // With w in halves, the integer numerators sum to 2^n per row.
+  // With w in halves, the integer numerators sum to 2^n per row. The product is expanded
+  // densely over monomial codes (sum_a m_a base^a) in 64-bit integers: every partial
+  // product has nonnegative coefficients summing to 2^(factors so far) <= 2^60, so no
+  // overflow, and the final ones (< 2^53, checked) are exact in double. The exact rational
+  // copies are made only when the exact fallback asks for them (build_to_bezier).
   QV_ASSERT(degree <= 60, "degree too high for exact dyadic subdivision: " << degree);
   children_ = midpoint_children(dim);
   const int base = degree + 1;
-  const int codes = static_cast<int>(std::pow(base, dim + 1) + 0.5);
+  std::array<int, 4> place{1, 0, 0, 0};  // base^a
+  for (int a = 1; a <= dim; ++a) place[static_cast<std::size_t>(a)] = place[static_cast<std::size_t>(a - 1)] * base;
+  const int codes = place[static_cast<std::size_t>(dim)] * base;
   std::vector<int> index_of(static_cast<std::size_t>(codes), -1);
   const auto code = [&](const MultiIndex& a) {
     int c = 0;
-    for (int x = dim; x >= 0; --x) c = c * base + a[static_cast<std::size_t>(x)];
+    for (int x = 0; x <= dim; ++x) c += a[static_cast<std::size_t>(x)] * place[static_cast<std::size_t>(x)];
     return c;
   };
   for (int i = 0; i < s; ++i) index_of[static_cast<std::size_t>(code(alphas_[static_cast<std::size_t>(i)]))] = i;
   const double scale = std::ldexp(1.0, -degree);
   subdivision_.assign(children_.size() * n_sz * n_sz, 0.0);
-  exact_->subdivision.assign(children_.size() * n_sz * n_sz, mpq_class(0));
+  std::vector<std::int64_t> poly(static_cast<std::size_t>(codes), 0), next(poly.size(), 0);
+  std::vector<int> live, next_live;
   for (std::size_t q = 0; q < children_.size(); ++q) {
     for (int r = 0; r < s; ++r) {
       const MultiIndex& beta = alphas_[static_cast<std::size_t>(r)];
-      // poly: map code -> integer coefficient, for monomials of the current degree
-      std::map<int, mpz_class> poly{{0, mpz_class(1)}};
-      std::map<int, MultiIndex> mono{{0, MultiIndex{0, 0, 0, 0}}};
+      live.assign(1, 0);
+      poly[0] = 1;
       for (int k = 0; k <= dim; ++k) {
+        const auto& w = children_[q][static_cast<std::size_t>(k)];
         for (int rep = 0; rep < beta[static_cast<std::size_t>(k)]; ++rep) {
-          std::map<int, mpz_class> next;
-          std::map<int, MultiIndex> next_mono;
-          for (const auto& [c, coef] : poly) {
+          next_live.clear();
+          for (const int c : live) {
+            const std::int64_t coef = poly[static_cast<std::size_t>(c)];
+            poly[static_cast<std::size_t>(c)] = 0;
             for (int a = 0; a <= dim; ++a) {
-              const int w = children_[q][static_cast<std::size_t>(k)][static_cast<std::size_t>(a)];
-              if (w == 0) continue;
-              MultiIndex m = mono[c];
-              ++m[static_cast<std::size_t>(a)];
-              const int nc = code(m);
-              next[nc] += coef * w;
-              next_mono[nc] = m;
+              const int wa = w[static_cast<std::size_t>(a)];
+              if (wa == 0) continue;
+              const auto nc = static_cast<std::size_t>(c + place[static_cast<std::size_t>(a)]);
+              if (next[nc] == 0) next_live.push_back(static_cast<int>(nc));
+              next[nc] += coef * wa;
             }
           }
           poly.swap(next);
-          mono.swap(next_mono);
+          live.swap(next_live);
         }
       }
-      for (const auto& [c, coef] : poly) {
+      for (const int c : live) {
+        const std::int64_t coef = poly[static_cast<std::size_t>(c)];
+        poly[static_cast<std::size_t>(c)] = 0;
         const int col = index_of[static_cast<std::size_t>(c)];
         QV_ASSERT(col >= 0, "monomial outside the space");
-        QV_ASSERT(coef.fits_ulong_p() && coef.get_ui() < (1ULL << 53), "non-exact entry");
+        QV_ASSERT(coef > 0 && coef < (std::int64_t{1} << 53), "non-exact entry");
         const std::size_t at = q * n_sz * n_sz + static_cast<std::size_t>(r) * n_sz +
                                static_cast<std::size_t>(col);
-        subdivision_[at] = static_cast<double>(coef.get_ui()) * scale;
-        exact_->subdivision[at] = mpq_class(coef, 1) / mpq_class(mpz_class(1) << degree);
+        subdivision_[at] = static_cast<double>(coef) * scale;
       }
     }
   }
@@ -291,6 +323,12 @@ double BernsteinSimplex::lagrange_to_bezier_norm() const {
 
 const BernsteinSimplex::Exact& BernsteinSimplex::exact() const {
   build_to_bezier();
+  // The dyadic subdivision entries are exact in double (constructor), hence as rationals;
+  // copied only here, not for lagrange_to_bezier(), which the sampled path needs.
+  std::call_once(exact_->subdivision_once, [this] {
+    exact_->subdivision.resize(subdivision_.size());
+    for (std::size_t i = 0; i < subdivision_.size(); ++i) exact_->subdivision[i] = subdivision_[i];
+  });
   return *exact_;
 }
 

@@ -12,4 +12,5 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/pyramid_jacobian_test.cpp
   analysis/linear_fast_path_test.cpp
   analysis/jacobian_batch_test.cpp
+  analysis/check_threads_test.cpp
 )

@@ -1,0 +1,91 @@
+// check_mesh's thread count: extra threads only for work worth them (each costs its wake-up
+// and the closing barrier, milliseconds on busy cores), and with several threads the
+// answers are those of one thread, bit for bit. The other determinism tests run meshes
+// small enough to stay on one thread; this one is large enough for two.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "jacobian_test_util.hpp"
+#include "quadval/check_report.hpp"
+
+namespace quadval {
+namespace {
+
+// `count` random curved elements of `type` (each with its own nodes) in one block.
+Mesh random_mesh(const ElementType& type, std::size_t count, unsigned seed) {
+  std::mt19937 rng(seed);
+  Mesh mesh;
+  ElementBlock blk;
+  blk.type = &type;
+  blk.entity_dim = type.dim;
+  blk.entity_tag = 1;
+  for (std::size_t e = 0; e < count; ++e) {
+    const std::vector<double> x = test::random_element(type, 0.12, rng);
+    blk.tags.push_back(blk.tags.size() + 1);
+    for (std::size_t v = 0; v < x.size() / 3; ++v) {
+      blk.nodes.push_back(static_cast<NodeIndex>(mesh.node_tags.size()));
+      mesh.node_tags.push_back(mesh.node_tags.size() + 1);
+      mesh.coords.insert(mesh.coords.end(), {x[3 * v], x[3 * v + 1], x[3 * v + 2]});
+    }
+  }
+  mesh.blocks.push_back(std::move(blk));
+  return mesh;
+}
+
+TEST(CheckThreads, SmallMeshRunsOnOneThread) {
+  const Mesh mesh = random_mesh(*find_element_type(ElementFamily::tetrahedron, 2, true), 600, 1);
+  CheckOptions o;
+  o.threads = 4;
+  EXPECT_EQ(check_mesh(mesh, o).threads, 1);  // 600 x 10 nodes x 20 coefficients: ~0.1 ms
+}
+
+TEST(CheckThreads, LargeWorkUsesThreadsWithIdenticalAnswers) {
+  // Validity: 8000 x 20 nodes x 84 coefficients = 1.3e7 work units, two threads' worth.
+  const Mesh mesh = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 8000, 2);
+  CheckOptions o;
+  o.threads = 1;
+  const CheckReport one = check_mesh(mesh, o);
+  o.threads = 8;  // capped by the work, not by the chunks (32)
+  const CheckReport many = check_mesh(mesh, o);
+  EXPECT_EQ(one.threads, 1);
+  EXPECT_EQ(many.threads, 2);
+  ASSERT_EQ(one.elements.size(), many.elements.size());
+  std::size_t answers[3] = {0, 0, 0};
+  for (std::size_t e = 0; e < one.elements.size(); ++e) {
+    const JacobianBounds& a = one.elements[e].bounds;
+    const JacobianBounds& b = many.elements[e].bounds;
+    ASSERT_EQ(a.validity, b.validity) << e;
+    ASSERT_EQ(a.jmin_lower, b.jmin_lower) << e;
+    ASSERT_EQ(a.jmin_upper, b.jmin_upper) << e;
+    ASSERT_EQ(a.jmax_lower, b.jmax_lower) << e;
+    ASSERT_EQ(a.jmax_upper, b.jmax_upper) << e;
+    ASSERT_EQ(a.subdivisions, b.subdivisions) << e;
+    ++answers[static_cast<int>(a.validity)];
+  }
+  EXPECT_EQ(check_csv(one), check_csv(many));
+  // Both answers occur, so the comparison covers more than one code path.
+  EXPECT_GT(answers[static_cast<int>(Validity::valid)], 0u);
+  EXPECT_GT(answers[static_cast<int>(Validity::invalid)], 0u);
+}
+
+TEST(CheckThreads, MeasuringCountsAsMoreWork) {
+  // Measuring weighs 50 times validity: 600 tetrahedra of order 2, 600 x 200 x 50 = 6e6
+  // units, stay on one thread.
+  const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 2, true), 600, 3);
+  CheckOptions o;
+  o.threads = 8;
+  o.measure = CheckMeasure::jacobian;
+  EXPECT_EQ(check_mesh(small, o).threads, 1);
+  // 3000 tetrahedra of order 3: 3000 x 1680 = 5e6 units for validity (one thread), 2.5e8
+  // measuring: 25 threads' worth, capped by the 12 chunks, then by the 8 requested.
+  const Mesh big = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 3000, 4);
+  o.measure = CheckMeasure::validity;
+  EXPECT_EQ(check_mesh(big, o).threads, 1);
+  o.measure = CheckMeasure::jacobian;
+  EXPECT_EQ(check_mesh(big, o).threads, 8);
+}
+
+}  // namespace
+}  // namespace quadval
