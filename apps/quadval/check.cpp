@@ -141,7 +141,7 @@ void add_check_command(CLI::App& app, int& exit_code) {
                   "Jacobian: before stopping with bounds wider than --tol, said in the summary)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_option("--threads", o->threads, "Threads (0: all cores); results do not depend on it")
+  cmd->add_option("--threads", o->threads, "Threads at most (0: all cores; small meshes use fewer, as threads would cost more than they save); results do not depend on it")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--worst", o->worst, "How many worst elements the summary lists")->capture_default_str();

@@ -48,7 +48,7 @@ struct CheckOptions {
   /// Absolute tolerance of mu and the scaled Jacobian (both at most 1), and their
   /// subdivision limit (max_subdivisions).
   double quality_abs_tol = 1e-2;
-  int threads = 0;  ///< 0: OpenMP's default
+  int threads = 0;  ///< at most this many (0: OpenMP's default); fewer when the work is small
   /// Called now and then from the calling thread with (elements done, total).
   std::function<void(std::size_t, std::size_t)> progress;
 };
@@ -100,7 +100,7 @@ struct CheckReport {
   std::size_t exact_fallbacks = 0;
   QualityCounts mu_counts, sj_counts;  ///< only for measures that include them
   double seconds = 0;                 ///< wall time of the analysis
-  int threads = 1;
+  int threads = 1;  ///< threads actually used
 
   std::size_t count(Validity v) const;
   std::size_t skipped() const;
