@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <map>
 #include <string>
 #include <vector>
@@ -59,16 +60,17 @@ struct ElementCheck {
   const ElementType* type = nullptr;
   bool analysed = false;  ///< false: skipped (pyramid, or an order beyond the supported ones)
   JacobianBounds bounds;
-  DistortionBounds distortion{std::nan(""), std::nan("")};  ///< NaN unless measured
-  /// Scale-free quality: jmin_lower / jmax_upper (like Gmsh's minJ/maxJ, but a bound).
-  double ratio_lower = std::nan("");
-  /// jmin_lower / javg (javg the mean of J): NaN when javg <= 0.
-  double jmin_over_javg = std::nan("");
-  /// Bounds on mu and on the scaled Jacobian: NaN unless computed (measure mu,
-  /// scaled_jacobian or all, and the type supported).
-  QualityBounds mu{std::nan(""), std::nan(""), 0, false};
-  QualityBounds sj{std::nan(""), std::nan(""), 0, false};
+  /// Scale-free quality: jmin_lower / jmax_upper rounded down (like Gmsh's minJ/maxJ, but
+  /// a bound); NaN when not analysed or jmax_upper <= 0. Computed, not stored: a million
+  /// elements' results stay small.
+  double ratio_lower() const noexcept;
+  /// jmin_lower / javg (javg the mean of J): NaN when not analysed or javg <= 0.
+  double jmin_over_javg() const noexcept;
 };
+
+/// The bounds of a quality measure not computed for an element.
+inline constexpr QualityBounds kNotComputed{std::numeric_limits<double>::quiet_NaN(),
+                                            std::numeric_limits<double>::quiet_NaN(), 0, false};
 
 /// Per quality measure (mu, scaled Jacobian): how many elements got bounds, how many were
 /// skipped (type or order not supported, or the element itself skipped), how many stopped
@@ -94,6 +96,11 @@ struct CheckReport {
   int dimension = 0;                  ///< the analysed dimension
   bool planar = false;                ///< 2D: all nodes share one z (J with n = +z)
   std::vector<ElementCheck> elements;  ///< elements of that dimension, in block order
+  /// Per element of `elements` (same index), only when the measure includes them, else
+  /// empty: kept apart so that a validity check of millions of elements stays small.
+  /// Entries are NaN / kNotComputed where not computed (type not supported, skipped).
+  std::vector<DistortionBounds> distortion;
+  std::vector<QualityBounds> mu, sj;
   /// Per Gmsh type id: counts of valid, invalid, undetermined, skipped.
   std::map<int, std::array<std::size_t, 4>> counts;
   std::vector<StageRow> stages;
@@ -101,6 +108,11 @@ struct CheckReport {
   QualityCounts mu_counts, sj_counts;  ///< only for measures that include them
   double seconds = 0;                 ///< wall time of the analysis
   int threads = 1;  ///< threads actually used
+
+  /// Element i's distortion, mu and scaled-Jacobian bounds (NaN when not computed).
+  DistortionBounds distortion_of(std::size_t i) const noexcept;
+  QualityBounds mu_of(std::size_t i) const noexcept;
+  QualityBounds sj_of(std::size_t i) const noexcept;
 
   std::size_t count(Validity v) const;
   std::size_t skipped() const;

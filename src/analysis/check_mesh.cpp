@@ -109,6 +109,9 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
     total += blk.size();
   }
   report.elements.resize(total);
+  if (measures_distortion(options.measure)) report.distortion.assign(total, DistortionBounds{NAN, NAN});
+  if (want_mu) report.mu.assign(total, kNotComputed);
+  if (want_sj) report.sj.assign(total, kNotComputed);
 
   // Build the shared spaces up front (once per type, outside the parallel region), except
   // for fast-path types: their space is built (thread-safely) only if an element needs it.
@@ -182,16 +185,15 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
             if (!out.tolerance_met) ++qc.tolerance_not_met;
           };
           // What every analysed element gets once its bounds are known.
-          const auto finish = [&](ElementCheck& ec, const double* xe, double seconds) {
+          const auto finish = [&](std::size_t index, const double* xe, double seconds) {
+            ElementCheck& ec = report.elements[index];
             ec.analysed = true;
             const JacobianBounds& b = ec.bounds;
-            if (b.jmax_upper > 0) ec.ratio_lower = next_down(b.jmin_lower / b.jmax_upper);
-            if (b.javg > 0) ec.jmin_over_javg = b.jmin_lower / b.javg;
             if (measures_distortion(options.measure))
-              ec.distortion = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
-            if (want_mu) quality(mu_supported(type), ec.mu, st.mu, xe, mu_bounds);
+              report.distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
+            if (want_mu) quality(mu_supported(type), report.mu[index], st.mu, xe, mu_bounds);
             if (want_sj)
-              quality(scaled_jacobian_supported(type), ec.sj, st.sj, xe,
+              quality(scaled_jacobian_supported(type), report.sj[index], st.sj, xe,
                       [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
                                        bool planar) { return scaled_jacobian_bounds_given(t, x, q, planar, v); });
             if (b.exact) ++st.exact;
@@ -219,7 +221,7 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
               const auto conn = blk.element(ch.first + i);
               if (decided[i]) {
                 ec.bounds = fast_bounds[i];
-                finish(ec, nullptr, share);  // no distortion: fast_path is validity only
+                finish(ch.out + i, nullptr, share);  // no distortion: fast_path is validity only
                 continue;
               }
               const double te = now_seconds();
@@ -232,7 +234,7 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
                                     errors.data(), ws.sample_scratch.product);
               ec.bounds = bounds_from_coefficients(space, coeffs.data(), errors[0], nodes.data(),
                                                    report.planar, bo, ws);
-              finish(ec, nodes.data(), share + (now_seconds() - te));
+              finish(ch.out + i, nodes.data(), share + (now_seconds() - te));
             }
           } else {
             // The product path (jacobian_product.hpp): the chunk's Bézier coefficients of J
@@ -259,7 +261,7 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
               const double* xe = nodes.data() + i * nn * 3;
               ec.bounds = bounds_from_coefficients(space, coeffs.data() + i * s, errors[i], xe,
                                                    report.planar, bo, ws);
-              finish(ec, xe, batch_share + (now_seconds() - te));
+              finish(ch.out + i, xe, batch_share + (now_seconds() - te));
             }
           }
         }
@@ -304,6 +306,28 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   return report;
 }
 
+DistortionBounds CheckReport::distortion_of(std::size_t i) const noexcept {
+  return distortion.empty() ? DistortionBounds{NAN, NAN} : distortion[i];
+}
+
+QualityBounds CheckReport::mu_of(std::size_t i) const noexcept {
+  return mu.empty() ? kNotComputed : mu[i];
+}
+
+QualityBounds CheckReport::sj_of(std::size_t i) const noexcept {
+  return sj.empty() ? kNotComputed : sj[i];
+}
+
+double ElementCheck::ratio_lower() const noexcept {
+  if (!analysed || !(bounds.jmax_upper > 0)) return std::nan("");
+  return next_down(bounds.jmin_lower / bounds.jmax_upper);
+}
+
+double ElementCheck::jmin_over_javg() const noexcept {
+  if (!analysed || !(bounds.javg > 0)) return std::nan("");
+  return bounds.jmin_lower / bounds.javg;
+}
+
 std::size_t CheckReport::count(Validity v) const {
   std::size_t n = 0;
   for (const auto& [id, c] : counts) n += c[static_cast<std::size_t>(v)];
@@ -318,7 +342,7 @@ std::size_t CheckReport::skipped() const {
 
 std::vector<std::size_t> CheckReport::worst_quality(std::size_t n, bool sj) const {
   std::vector<std::size_t> idx;
-  const auto key = [&](std::size_t i) { return sj ? elements[i].sj.lower : elements[i].mu.lower; };
+  const auto key = [&](std::size_t i) { return (sj ? sj_of(i) : mu_of(i)).lower; };
   for (std::size_t i = 0; i < elements.size(); ++i)
     if (!std::isnan(key(i))) idx.push_back(i);
   const std::size_t m = std::min(n, idx.size());
@@ -336,7 +360,7 @@ std::vector<std::size_t> CheckReport::worst(std::size_t n) const {
   const bool by_distortion = measures_distortion(measure);
   const auto key = [&](std::size_t i) {
     const ElementCheck& e = elements[i];
-    const double k = by_distortion ? e.distortion.lower : e.ratio_lower;
+    const double k = by_distortion ? distortion_of(i).lower : e.ratio_lower();
     return std::isnan(k) ? -INFINITY : k;
   };
   for (std::size_t i = 0; i < elements.size(); ++i)

@@ -23,8 +23,8 @@ const char* answer(const ElementCheck& e) {
 }
 
 // The scale-free quality the histogram and the worst list use.
-double quality(const CheckReport& r, const ElementCheck& e) {
-  return measures_distortion(r.measure) ? e.distortion.lower : e.ratio_lower;
+double quality(const CheckReport& r, std::size_t i) {
+  return measures_distortion(r.measure) ? r.distortion_of(i).lower : r.elements[i].ratio_lower();
 }
 
 // Histogram lines of values in [-1, 1] (bins of 0.1 from 0, one bin below 0).
@@ -47,8 +47,8 @@ void quality_section(std::string& out, const CheckReport& r, bool sj, std::size_
   const char* name = sj ? "scaled Jacobian" : "mu";
   std::vector<double> lows;
   double sum = 0;
-  for (const ElementCheck& e : r.elements) {
-    const double lo = sj ? e.sj.lower : e.mu.lower;
+  for (std::size_t i = 0; i < r.elements.size(); ++i) {
+    const double lo = (sj ? r.sj_of(i) : r.mu_of(i)).lower;
     if (std::isnan(lo)) continue;
     lows.push_back(lo);
     sum += lo;
@@ -65,9 +65,9 @@ void quality_section(std::string& out, const CheckReport& r, bool sj, std::size_
     out += "\n";
     return;
   }
-  const ElementCheck& lowest = r.elements[r.worst_quality(1, sj).front()];
+  const std::size_t lowest = r.worst_quality(1, sj).front();
   out += fmt::format("  {} lower bounds: min {:.6g} (element {}), mean {:.6g}\n", name,
-                     sj ? lowest.sj.lower : lowest.mu.lower, lowest.tag, sum / static_cast<double>(lows.size()));
+                     (sj ? r.sj_of(lowest) : r.mu_of(lowest)).lower, r.elements[lowest].tag, sum / static_cast<double>(lows.size()));
   out += fmt::format("  histogram of the {} lower bounds\n", name);
   histogram(out, lows);
   const auto wl = r.worst_quality(worst, sj);
@@ -76,7 +76,7 @@ void quality_section(std::string& out, const CheckReport& r, bool sj, std::size_
     out += fmt::format("  {:>10} {:<22} {:<13} {:>13} {:>13} {:>8}\n", "tag", "type", "validity", "lower", "upper", "subdiv");
     for (std::size_t i : wl) {
       const ElementCheck& e = r.elements[i];
-      const QualityBounds& q = sj ? e.sj : e.mu;
+      const QualityBounds q = sj ? r.sj_of(i) : r.mu_of(i);
       out += fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>8}\n", e.tag, e.type->name, answer(e), q.lower,
                          q.upper, q.subdivisions);
     }
@@ -145,9 +145,9 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   static constexpr double kEdges[] = {-INFINITY, 0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, INFINITY};
   std::array<std::size_t, 11> bins{};
   std::size_t undefined = 0, total = 0;
-  for (const ElementCheck& e : r.elements) {
-    if (!e.analysed) continue;
-    const double q = quality(r, e);
+  for (std::size_t i = 0; i < r.elements.size(); ++i) {
+    if (!r.elements[i].analysed) continue;
+    const double q = quality(r, i);
     if (std::isnan(q)) {
       ++undefined;
       continue;
@@ -173,7 +173,7 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
     for (std::size_t i : w) {
       const ElementCheck& e = r.elements[i];
       line(fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>11.5g}", e.tag, e.type->name, answer(e),
-                       e.bounds.jmin_lower, e.bounds.jmin_upper, quality(r, e)));
+                       e.bounds.jmin_lower, e.bounds.jmin_upper, quality(r, i)));
     }
   }
   const bool mu = measures_mu(r.measure), sj = measures_scaled_jacobian(r.measure);
@@ -191,17 +191,20 @@ std::string check_csv(const CheckReport& r) {
   std::string out =
       "tag,type,validity,jmin_lower,jmin_upper,jmax_lower,jmax_upper,distortion_lower,subdivisions,"
       "distortion_upper,jmin_over_javg,ratio_lower,stage,exact,mu_lower,mu_upper,sj_lower,sj_upper\n";
-  for (const ElementCheck& e : r.elements) {
+  for (std::size_t i = 0; i < r.elements.size(); ++i) {
+    const ElementCheck& e = r.elements[i];
     const JacobianBounds& b = e.bounds;
+    const DistortionBounds d = r.distortion_of(i);
+    const QualityBounds mu = r.mu_of(i), sj = r.sj_of(i);
     if (!e.analysed) {
       out += fmt::format("{},{},skipped,nan,nan,nan,nan,nan,0,nan,nan,nan,-1,0,nan,nan,nan,nan\n", e.tag, e.type->gmsh_id);
       continue;
     }
     out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag, e.type->gmsh_id, answer(e),
                        num(b.jmin_lower), num(b.jmin_upper), num(b.jmax_lower), num(b.jmax_upper),
-                       num(e.distortion.lower), b.subdivisions, num(e.distortion.upper),
-                       num(e.jmin_over_javg), num(e.ratio_lower), b.stage, b.exact ? 1 : 0, num(e.mu.lower),
-                       num(e.mu.upper), num(e.sj.lower), num(e.sj.upper));
+                       num(d.lower), b.subdivisions, num(d.upper),
+                       num(e.jmin_over_javg()), num(e.ratio_lower()), b.stage, b.exact ? 1 : 0, num(mu.lower),
+                       num(mu.upper), num(sj.lower), num(sj.upper));
   }
   return out;
 }
@@ -246,20 +249,25 @@ std::string check_json(const CheckReport& r) {
   for (std::size_t i : r.worst(10)) worst.push_back(r.elements[i].tag);
   summary["worst_tags"] = worst;
   json elements = json::array();
-  for (const ElementCheck& e : r.elements) {
+  for (std::size_t i = 0; i < r.elements.size(); ++i) {
+    const ElementCheck& e = r.elements[i];
     const JacobianBounds& b = e.bounds;
+    const DistortionBounds d = r.distortion_of(i);
+    const QualityBounds mu = r.mu_of(i), sj = r.sj_of(i);
     json je = {{"tag", e.tag}, {"type", e.type->gmsh_id}, {"validity", answer(e)}};
     if (e.analysed) {
       je["jmin"] = {jnum(b.jmin_lower), jnum(b.jmin_upper)};
       je["jmax"] = {jnum(b.jmax_lower), jnum(b.jmax_upper)};
-      je["distortion"] = {jnum(e.distortion.lower), jnum(e.distortion.upper)};
-      je["ratio_lower"] = jnum(e.ratio_lower);
-      je["jmin_over_javg"] = jnum(e.jmin_over_javg);
+      je["distortion"] = {jnum(d.lower), jnum(d.upper)};
+      je["ratio_lower"] = jnum(e.ratio_lower());
+      je["jmin_over_javg"] = jnum(e.jmin_over_javg());
       je["subdivisions"] = b.subdivisions;
       je["stage"] = b.stage;
       je["exact"] = b.exact;
-      if (!std::isnan(e.mu.lower)) je["mu"] = {{"lower", e.mu.lower}, {"upper", e.mu.upper}, {"subdivisions", e.mu.subdivisions}, {"tolerance_met", e.mu.tolerance_met}};
-      if (!std::isnan(e.sj.lower)) je["sj"] = {{"lower", e.sj.lower}, {"upper", e.sj.upper}, {"subdivisions", e.sj.subdivisions}, {"tolerance_met", e.sj.tolerance_met}};
+      for (const auto& [name, q] : {std::pair{"mu", mu}, std::pair{"sj", sj}})
+        if (!std::isnan(q.lower))
+          je[name] = {{"lower", q.lower}, {"upper", q.upper}, {"subdivisions", q.subdivisions},
+                      {"tolerance_met", q.tolerance_met}};
     }
     elements.push_back(std::move(je));
   }
@@ -282,10 +290,10 @@ std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh
           v = c.bounds.validity == Validity::valid ? 1 : c.bounds.validity == Validity::invalid ? -1 : 0;
           lo = c.bounds.jmin_lower;
           hi = c.bounds.jmin_upper;
-          ratio = c.ratio_lower;
-          dist = c.distortion.lower;
-          mu = c.mu.lower;
-          sj = c.sj.lower;
+          ratio = c.ratio_lower();
+          dist = r.distortion_of(k - 1).lower;
+          mu = r.mu_of(k - 1).lower;
+          sj = r.sj_of(k - 1).lower;
         }
       }
       f[0].second.push_back(v);
