@@ -1,9 +1,10 @@
-// Throughput of the certified quality measure mu (mu_bounds, default tolerance 1e-3) next
-// to the validity check of the same elements (jacobian_bounds, validity goal): batches of
-// random curved elements of each family and order (reference nodes through a random
-// near-identity affine map, every node moved by up to 0.1 / order).
+// Throughput of the certified quality measures mu (mu_bounds, default tolerance 1e-3) and
+// the scaled Jacobian (scaled_jacobian_bounds) next to the validity check of the same
+// elements (jacobian_bounds, validity goal): batches of random curved elements of each
+// family and order (reference nodes through a random near-identity affine map, every node
+// moved by up to 0.1 / order).
 //
-//   build-mu/bench/quadval_bench --benchmark_filter='Mu|Validity' --benchmark_repetitions=3
+//   build-mu/bench/quadval_bench --benchmark_filter='Mu|ScaledJacobian|Validity' --benchmark_repetitions=3
 // Counters: elements/s; "subdiv" is the mean number of subdomains split per element for mu.
 #include <benchmark/benchmark.h>
 
@@ -13,6 +14,7 @@
 #include "quadval/jacobian_bounds.hpp"
 #include "quadval/lagrange_basis.hpp"
 #include "quadval/mu_bounds.hpp"
+#include "quadval/scaled_jacobian.hpp"
 
 namespace quadval {
 namespace {
@@ -65,6 +67,29 @@ void BM_Mu(benchmark::State& state) {
   state.SetLabel(std::string(type.name));
 }
 
+// The certified minimum of the scaled Jacobian (scaled_jacobian_bounds, default tolerance).
+void BM_ScaledJacobian(benchmark::State& state) {
+  const ElementType& type = *find_element_type(static_cast<int>(state.range(0)));
+  const int kBatch = batch(type);
+  const auto x = random_elements(type, kBatch);
+  const std::size_t stride = 3 * static_cast<std::size_t>(type.num_nodes);
+  const QualityOptions opt;
+  long subdivisions = 0;
+  double sink = 0;
+  for (auto _ : state) {
+    for (int e = 0; e < kBatch; ++e) {
+      const QualityBounds b =
+          scaled_jacobian_bounds(type, std::span<const double>(x.data() + e * stride, stride), opt, true);
+      sink += b.lower;
+      subdivisions += b.subdivisions;
+    }
+  }
+  benchmark::DoNotOptimize(sink);
+  state.SetItemsProcessed(state.iterations() * kBatch);
+  state.counters["subdiv"] = double(subdivisions) / double(state.iterations() * kBatch);
+  state.SetLabel(std::string(type.name));
+}
+
 void BM_Validity(benchmark::State& state) {
   const ElementType& type = *find_element_type(static_cast<int>(state.range(0)));
   const int kBatch = batch(type);
@@ -88,6 +113,7 @@ void BM_Validity(benchmark::State& state) {
 // hexahedra 8, 27 (orders 1-3 where mu_supported).
 #define QV_MU_TYPES ->Arg(2)->Arg(9)->Arg(21)->Arg(3)->Arg(10)->Arg(36)->Arg(4)->Arg(11)->Arg(29)->Arg(6)->Arg(13)->Arg(5)->Arg(12)
 BENCHMARK(BM_Mu) QV_MU_TYPES->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ScaledJacobian) QV_MU_TYPES->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Validity) QV_MU_TYPES->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -47,6 +47,10 @@
 ///      replaces the (a, K) bounding box and bounding curve of Paper V §5-6, whose bounds
 ///      converge only linearly at a fold of the (a, K) image and lose all information on w
 ///      near the ideal element (w = (K - a^3 + 3a) / 2 cancels).
+///   Constant W (straight-sided simplices, parallelograms, parallelepipeds, detected from
+///   W's control values with their error bound): R >= the closed-form bound of one 2x2 or
+///   3x3 metric (Gershgorin discs of V^T M V at approximate eigenvectors V, Ostrowski's
+///   theorem for V's non-orthogonality; src/analysis/mu_constant.hpp), no subdivision.
 /// upper: the minimum over the corners of all subdomains of an upper bound of mu_pw there
 ///   (Rayleigh quotients of W at approximate eigenvectors of W^T W, enclosed in interval
 ///   fashion: lambda_min <= |W v|^2 / |v|^2 <= lambda_max for any v).

@@ -1,6 +1,7 @@
 // Certified bounds of the quality measure mu (thesis, Paper V): validity first (the
-// Jacobian engine), then best-first adaptive subdivision of the control values of W, each
-// subdomain bounded by mu_metric.cpp (lower) and by its corner values (upper).
+// Jacobian engine), the closed form of mu_constant.hpp when W is constant, then
+// best-first adaptive subdivision of the control values of W, each subdomain bounded by
+// mu_metric.cpp (lower) and by its corner values (upper).
 #include "quadval/mu_bounds.hpp"
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <queue>
 #include <vector>
 
+#include "analysis/mu_constant.hpp"
 #include "analysis/mu_metric.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
@@ -134,6 +136,23 @@ QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
     out.upper = sqrt_up(r_upper);
     out.tolerance_met = out.upper <= options.abs_tol;
     return out;
+  }
+
+  // Constant W (straight-sided simplices, parallelograms, parallelepipeds): the closed
+  // form of mu_constant.hpp settles it without products when the gap is met. Cheap test
+  // first: W's control values agree to 1e-9 relative.
+  if (mu_constant_path_enabled()) {
+    const double delta = constant_w_radius(space, pool.data(), err0);
+    double wmax = 0;
+    for (std::size_t i = 0; i < block; ++i) wmax = std::max(wmax, std::abs(pool[i]));
+    if (delta <= 1e-9 * wmax) {
+      out.lower = sqrt_down(constant_ratio_lower(space, pool.data(), delta));
+      out.upper = sqrt_up(r_upper);
+      if (out.upper - out.lower <= options.abs_tol) {
+        out.tolerance_met = true;
+        return out;
+      }
+    }
   }
 
   const auto tol_r = [&] {

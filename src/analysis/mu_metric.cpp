@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <tuple>
@@ -63,12 +64,16 @@ void MuMetric::product(const BernsteinProduct& table,
   out.c.assign(static_cast<std::size_t>(table.h_size()), 0.0);
   double prop = 0, scale_fg = 0;
   int k = 0;
+  std::array<BernsteinProduct::Term, 8> batch{};
+  QV_ASSERT(terms.size() <= batch.size(), terms.size() << " terms");
   for (const auto& [s, f, g] : terms) {
-    table.multiply_add(f->c.data(), g->c.data(), s, out.c.data());
+    batch[static_cast<std::size_t>(k)] = {s, f->c.data(), g->c.data()};
     prop += std::abs(s) * (f->mag * g->err + f->err * g->mag + f->err * g->err);
     scale_fg += std::abs(s) * f->mag * g->mag;
     ++k;
   }
+  table.multiply_add_sum(std::span<const BernsteinProduct::Term>(batch.data(), static_cast<std::size_t>(k)),
+                         out.c.data());
   out.err = (prop + table.rounding(k) * scale_fg) * kSlack;
   out.mag = max_abs(out.c);
 }

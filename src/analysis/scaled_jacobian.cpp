@@ -46,7 +46,7 @@ struct Leaf {
 };
 
 struct Scratch {
-  std::vector<double> values, work;
+  std::vector<double> values, work, parent, parent_err, child, child_err;
   std::vector<double> pool, pool_err;
   std::vector<int> free_slots;
   std::vector<Leaf> heap;
@@ -130,6 +130,7 @@ class Bounder {
 };
 
 // A coefficient vector with its bounds: |entries| <= m (computed), |entry - exact| <= e.
+// Kept in thread-local scratch and overwritten in place (no allocation once warm).
 struct Poly {
   std::vector<FactorDegree> deg;
   std::vector<double> c;
@@ -138,51 +139,78 @@ struct Poly {
 
 void refresh_magnitude(Poly& p) { p.b.m = max_abs(p.c.data(), p.c.size()); }
 
+struct ProductTerm {
+  const Poly* f;
+  const Poly* g;
+  double scale;
+};
+
+// The shared table of (f, g), looked up once per thread and degree pair (no lock, no
+// allocation per product).
+const BernsteinProduct& product_table(const Poly& f, const Poly& g) {
+  using Key = std::array<int, 12>;
+  thread_local std::map<Key, const BernsteinProduct*> tables;
+  Key key{};
+  std::size_t n = 0;
+  for (const Poly* p : {&f, &g})
+    for (const FactorDegree& fd : p->deg) key[n++] = fd.dim * 64 + fd.degree + 1;
+  const BernsteinProduct*& slot = tables[key];
+  if (slot == nullptr) slot = &bernstein_product(f.deg, g.deg);
+  return *slot;
+}
+
 // h = sum_t scale_t f_t g_t (Paper V Prop. 4), all pairs (f_t, g_t) of the same two
 // spaces; error: propagated input errors plus bernstein_product's rounding bound.
-Poly product_sum(const std::vector<std::pair<const Poly*, const Poly*>>& terms, const std::vector<double>& scales) {
-  // The shared tables, looked up once per thread and degree pair (no lock per product).
-  thread_local std::map<std::vector<int>, const BernsteinProduct*> tables;
-  std::vector<int> key;
-  for (const Poly* p : {terms[0].first, terms[0].second})
-    for (const FactorDegree& fd : p->deg) key.insert(key.end(), {fd.dim, fd.degree});
-  const BernsteinProduct*& slot = tables[key];
-  if (slot == nullptr) slot = &bernstein_product(terms[0].first->deg, terms[0].second->deg);
-  const BernsteinProduct& table = *slot;
-  Poly h;
-  h.deg = product_degrees(terms[0].first->deg, terms[0].second->deg);
+// @pre h is none of the inputs
+void product_sum(std::initializer_list<ProductTerm> terms, Poly& h) {
+  const ProductTerm& first = *terms.begin();
+  const BernsteinProduct& table = product_table(*first.f, *first.g);
+  h.deg.resize(first.f->deg.size());
+  for (std::size_t i = 0; i < h.deg.size(); ++i)
+    h.deg[i] = {first.f->deg[i].dim, first.f->deg[i].degree + first.g->deg[i].degree};
   h.c.assign(static_cast<std::size_t>(table.h_size()), 0.0);
   double magnitude = 0, propagated = 0;
-  for (std::size_t t = 0; t < terms.size(); ++t) {
-    const Poly& f = *terms[t].first;
-    const Poly& g = *terms[t].second;
-    table.multiply_add(f.c.data(), g.c.data(), scales[t], h.c.data());
-    const double sc = std::abs(scales[t]);
+  std::array<BernsteinProduct::Term, 8> batch{};
+  QV_ASSERT(terms.size() <= batch.size(), terms.size() << " terms");
+  std::size_t k = 0;
+  for (const ProductTerm& t : terms) {
+    const Poly& f = *t.f;
+    const Poly& g = *t.g;
+    QV_ASSERT(&f != &h && &g != &h, "product into its own input");
+    batch[k++] = {t.scale, f.c.data(), g.c.data()};
+    const double sc = std::abs(t.scale);
     magnitude += sc * f.b.m * g.b.m;
     propagated += sc * (f.b.m * g.b.e + (g.b.m + g.b.e) * f.b.e);
   }
+  table.multiply_add_sum(std::span<const BernsteinProduct::Term>(batch.data(), k), h.c.data());
   refresh_magnitude(h);
-  h.b.e = propagated + table.rounding(static_cast<int>(terms.size())) * magnitude;
-  return h;
+  h.b.e = propagated + table.rounding(static_cast<int>(k)) * magnitude;
 }
 
-// p = sum_t w_t q_t (same space), w_t in {-1, 1} or |w_t| <= 1 (a reference direction).
-Poly linear_sum(const std::vector<const Poly*>& q, const std::vector<double>& w) {
-  Poly p;
+// p = sum_t w_t q_t (same space, t < n), w_t in {-1, 1} or |w_t| <= 1 (a reference
+// direction).
+void linear_sum(const Poly* const* q, const double* w, std::size_t n, Poly& p) {
   p.deg = q[0]->deg;
   p.c.assign(q[0]->c.size(), 0.0);
   double e = 0, m = 0;
-  for (std::size_t t = 0; t < q.size(); ++t) {
+  for (std::size_t t = 0; t < n; ++t) {
     QV_ASSERT(q[t]->c.size() == p.c.size(), "spaces differ");
     for (std::size_t i = 0; i < p.c.size(); ++i) p.c[i] += w[t] * q[t]->c[i];
     e += std::abs(w[t]) * q[t]->b.e;
     m += std::abs(w[t]) * q[t]->b.m;
   }
   refresh_magnitude(p);
-  // Each product w q rounds once (exact for w = +-1) and each of the q.size() - 1 sums once.
-  p.b.e = e + rounding_gamma(2 * static_cast<int>(q.size())) * m;
-  return p;
+  // Each product w q rounds once (exact for w = +-1) and each of the n - 1 sums once.
+  p.b.e = e + rounding_gamma(2 * static_cast<int>(n)) * m;
 }
+
+// The polynomials of one element, reused from element to element.
+struct Polys {
+  std::array<std::array<Poly, 3>, 3> col;
+  std::array<Poly, 3> w, v;
+  Poly jac, n, jsq, one, sq, prod, tmp;
+  std::vector<Poly> dk;
+};
 
 }  // namespace
 
@@ -224,7 +252,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
       ws.values[i * 3 + j] = nodes[3 * i + j] - nodes[j];
       range = std::max(range, std::abs(ws.values[i * 3 + j]));
     }
-  std::array<std::array<Poly, 3>, 3> col;
+  thread_local Polys polys;
+  auto& col = polys.col;
   for (std::size_t c = 0; c < udim; ++c) {
     const std::vector<double>& m = space.column_map(static_cast<int>(c));
     const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
@@ -246,62 +275,72 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   // 2. J, N = |V|^2 and D_k = prod_j |v_kj|^2 by Bernstein products.
   const auto ref = reference_direction(type, nodes.data(), planar);
   const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2
-  Poly jac, n;
+  Poly& jac = polys.jac;
+  Poly& n = polys.n;
+  auto& w = polys.w;
   if (dim == 3) {
-    std::array<Poly, 3> w;  // c_1 x c_2
-    for (std::size_t x = 0; x < 3; ++x) {
+    for (std::size_t x = 0; x < 3; ++x) {  // w = c_1 x c_2
       const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
-      w[x] = product_sum({{&col[1][y], &col[2][z]}, {&col[1][z], &col[2][y]}}, {1.0, -1.0});
+      product_sum({{&col[1][y], &col[2][z], 1.0}, {&col[1][z], &col[2][y], -1.0}}, w[x]);
     }
-    jac = product_sum({{&col[0][0], &w[0]}, {&col[0][1], &w[1]}, {&col[0][2], &w[2]}}, {1.0, 1.0, 1.0});
-    n = product_sum({{&jac, &jac}}, {1.0});
+    product_sum({{&col[0][0], &w[0], 1.0}, {&col[0][1], &w[1], 1.0}, {&col[0][2], &w[2], 1.0}}, jac);
+    product_sum({{&jac, &jac, 1.0}}, n);
   } else if (dim == 2) {
-    std::array<Poly, 3> w;  // c_0 x c_1
-    for (std::size_t x = 0; x < 3; ++x) {
+    for (std::size_t x = 0; x < 3; ++x) {  // w = c_0 x c_1
       const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
-      w[x] = product_sum({{&col[0][y], &col[1][z]}, {&col[0][z], &col[1][y]}}, {1.0, -1.0});
+      product_sum({{&col[0][y], &col[1][z], 1.0}, {&col[0][z], &col[1][y], -1.0}}, w[x]);
     }
-    jac = linear_sum({&w[0], &w[1], &w[2]}, {ref[0], ref[1], ref[2]});
-    n = area ? product_sum({{&w[0], &w[0]}, {&w[1], &w[1]}, {&w[2], &w[2]}}, {1.0, 1.0, 1.0})
-             : product_sum({{&jac, &jac}}, {1.0});
+    const Poly* q[3] = {&w[0], &w[1], &w[2]};
+    linear_sum(q, ref.data(), 3, jac);
+    if (area)
+      product_sum({{&w[0], &w[0], 1.0}, {&w[1], &w[1], 1.0}, {&w[2], &w[2], 1.0}}, n);
+    else
+      product_sum({{&jac, &jac, 1.0}}, n);
   } else {
-    jac = linear_sum({&col[0][0], &col[0][1], &col[0][2]}, {ref[0], ref[1], ref[2]});
-    n = product_sum({{&jac, &jac}}, {1.0});
+    const Poly* q[3] = {&col[0][0], &col[0][1], &col[0][2]};
+    linear_sum(q, ref.data(), 3, jac);
+    product_sum({{&jac, &jac, 1.0}}, n);
   }
   // J in the squared space (J * 1, 1 with all coefficients 1 in J's space), for the sign
   // tests of the subdomains; not needed when J > 0 is proven on the whole element.
-  Poly jsq;
+  Poly& jsq = polys.jsq;
   if (v == Validity::valid) {
     jsq.deg = space.squared_degrees();
     jsq.c.assign(s2, 1.0);
     jsq.b = {1, 0};
   } else {
-    Poly one;
+    Poly& one = polys.one;
     one.deg = jac.deg;
     one.c.assign(jac.c.size(), 1.0);
     one.b = {1, 0};
-    jsq = product_sum({{&jac, &one}}, {1.0});
+    product_sum({{&jac, &one, 1.0}}, jsq);
   }
-  std::vector<Poly> dk(frames);
+  auto& dk = polys.dk;
+  dk.resize(frames);
   for (std::size_t f = 0; f < frames; ++f) {
     const Frame& fr = space.frames()[f];
-    Poly prod;
+    Poly& prod = polys.prod;
     for (std::size_t j = 0; j < udim; ++j) {
-      std::array<Poly, 3> v;
+      auto& vj = polys.v;
       for (std::size_t x = 0; x < 3; ++x) {
-        std::vector<const Poly*> q;
-        std::vector<double> w;
+        const Poly* q[3];
+        double wt[3];
+        std::size_t terms = 0;
         for (std::size_t c = 0; c < udim; ++c)
           if (fr[j][c] != 0) {
-            q.push_back(&col[c][x]);
-            w.push_back(fr[j][c]);
+            q[terms] = &col[c][x];
+            wt[terms++] = fr[j][c];
           }
-        v[x] = linear_sum(q, w);
+        linear_sum(q, wt, terms, vj[x]);
       }
-      Poly sq = product_sum({{&v[0], &v[0]}, {&v[1], &v[1]}, {&v[2], &v[2]}}, {1.0, 1.0, 1.0});
-      prod = j == 0 ? std::move(sq) : product_sum({{&prod, &sq}}, {1.0});
+      Poly& sq = j == 0 ? prod : polys.sq;
+      product_sum({{&vj[0], &vj[0], 1.0}, {&vj[1], &vj[1], 1.0}, {&vj[2], &vj[2], 1.0}}, sq);
+      if (j > 0) {
+        product_sum({{&prod, &sq, 1.0}}, polys.tmp);
+        std::swap(prod, polys.tmp);
+      }
     }
-    dk[f] = std::move(prod);
+    std::swap(dk[f], prod);
   }
 
   // 3. The root: vectors J, N, D_k in the squared space, slot 0 of the leaf pool.
@@ -349,7 +388,10 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   push(0);
 
   QualityBounds out;
-  std::vector<double> child(stride), child_err(nvec);
+  ws.child.resize(stride);
+  ws.child_err.resize(nvec);
+  auto& child = ws.child;
+  auto& child_err = ws.child_err;
   while (!ws.heap.empty()) {
     const Leaf top = ws.heap.front();
     if (up(upper - std::min(top.lower, settled)) <= tol) break;
@@ -358,11 +400,14 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     ws.heap.pop_back();
     ++out.subdivisions;
     ws.free_slots.push_back(top.slot);
+    // The parent's slot is reused by its children: copy it out first.
     const std::size_t parent_off = static_cast<std::size_t>(top.slot) * stride;
-    const std::vector<double> parent(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
-                                     ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
-    const std::vector<double> parent_err(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
-                                         ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
+    ws.parent.assign(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
+                     ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
+    ws.parent_err.assign(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
+                         ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
+    const auto& parent = ws.parent;
+    const auto& parent_err = ws.parent_err;
     for (int q = 0; q < b2.num_children(); ++q) {
       for (std::size_t v = 0; v < nvec; ++v) {
         const double* p = parent.data() + v * s2;

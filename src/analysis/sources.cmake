@@ -10,6 +10,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/scaled_jacobian.cpp
   src/analysis/mu_space.cpp
   src/analysis/mu_metric.cpp
+  src/analysis/mu_constant.cpp
   src/analysis/mu_bounds.cpp
   src/analysis/check_mesh.cpp
   src/analysis/check_report.cpp

@@ -1,6 +1,20 @@
-// Bernstein products (thesis, Paper V Prop. 4): per-factor tables of (i, j, k, weight),
-// applied as a tensor product of the factor tables. Weights are exact rationals rounded
-// once to double.
+// Bernstein products (thesis, Paper V Prop. 4), two kernels computing the same sums:
+//  - small products: per-factor tables of (i, j, k, weight), applied as a tensor product
+//    of the factor tables; weights are exact rationals rounded once to double;
+//  - large products: the scaled form. With alpha the multinomials,
+//      h_k = (1 / alpha_k) sum_{i + j = k} (alpha_i f_i) (alpha_j g_j),
+//    a plain N-D convolution of the scaled coefficients (grids of the barycentric indices),
+//    computed as contiguous runs in h's strides; a sum of products in the same spaces is
+//    accumulated in scaled form and unscaled once (multiply_add_sum).
+// Error model of the scaled form, per term alpha_i alpha_j / alpha_k f_i g_j: alpha_i,
+// alpha_j, 1 / alpha_k each rounded to within one ulp (2u each), scale * alpha_i (u),
+// times f_i (u), alpha_j g_j (u), the term product (u, or none with a fused multiply-add),
+// the unscaling product (u) and the final addition into h (u): at most 12 roundings, so
+// the computed term is the exact convex-weighted term times (1 + theta_12). The k terms
+// of one cell of a sum of `products` products (k <= products * max_terms; the zero
+// padding adds exact zeros) are summed recursively (gamma_k, Higham §3.1). Together:
+// |computed - exact| <= gamma_{products * max_terms + 16} sum |scale| max|f| max|g|,
+// since the exact convex weights of one k sum to 1 — the same bound as the entry kernel.
 #include "bezier/bernstein_product.hpp"
 
 #include <gmpxx.h>
@@ -45,6 +59,9 @@ int binomial_size(int dim, int degree) {
   for (int c = 1; c <= dim; ++c) s = s * (degree + c) / c;
   return static_cast<int>(s);
 }
+
+// Products with fewer coefficient pairs use the weighted-entry loop (measured, mu_bench).
+constexpr long kEntryKernelBelow = 2048;
 
 }  // namespace
 
@@ -123,18 +140,20 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
   f_size_ = fs;
   g_size_ = gs;
   h_size_ = hs;
-  // Grids of the convolution kernel.
+  // Grids of the convolution kernel, all addressed with the strides of h's grid.
+  std::array<int, 3> hdims{1, 1, 1};
+  {
+    int coord = 0;
+    for (const FactorDegree& d : h_degrees_)
+      for (int c = 0; c < d.dim; ++c) hdims[static_cast<std::size_t>(coord++)] = d.degree + 1;
+  }
+  h_cells_ = hdims[0] * hdims[1] * hdims[2];
   const auto make_grid = [&](const std::vector<FactorDegree>& deg, bool invert) {
     Grid grid;
-    int coord = 0;
     std::vector<std::vector<MultiIndex>> idx;
-    for (const FactorDegree& d : deg) {
-      for (int c = 0; c < d.dim; ++c) grid.dims[static_cast<std::size_t>(coord++)] = d.degree + 1;
-      idx.push_back(simplex_multi_indices(d.dim, d.degree));
-    }
+    for (const FactorDegree& d : deg) idx.push_back(simplex_multi_indices(d.dim, d.degree));
     int size = 1;
     for (const auto& v : idx) size *= static_cast<int>(v.size());
-    const int d0 = grid.dims[0], d1 = grid.dims[1];
     for (int i = 0; i < size; ++i) {
       int rest = i, c = 0;
       std::array<int, 3> pos{0, 0, 0};
@@ -146,59 +165,89 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
         alpha *= multinomial(a, deg[f].dim);
         for (int k = 1; k <= deg[f].dim; ++k) pos[static_cast<std::size_t>(c++)] = a[static_cast<std::size_t>(k)];
       }
-      grid.cell.push_back(pos[0] + d0 * (pos[1] + d1 * pos[2]));
+      grid.offset.push_back(pos[0] + hdims[0] * (pos[1] + hdims[1] * pos[2]));
       grid.scale.push_back(invert ? nearest(mpq_class(mpz_class(1), alpha)) : nearest(mpq_class(alpha)));
     }
-    // Valid cells of a row form a prefix along coordinate 0 (sum of a factor's indices <= n).
-    grid.row_len.assign(static_cast<std::size_t>(grid.dims[1] * grid.dims[2]), 0);
-    for (int cell : grid.cell) {
-      const int r = cell / d0;
-      grid.row_len[static_cast<std::size_t>(r)] = std::max(grid.row_len[static_cast<std::size_t>(r)], cell % d0 + 1);
+    // Runs: the valid cells of a row are a prefix (an index sum <= n per simplex factor);
+    // consecutive rows merge into one run while at least half of its cells are valid
+    // (whole planes of tensor grids; row by row for simplices, mostly padding otherwise).
+    std::map<int, std::array<int, 2>> rows;  // row start offset -> (first, end) offsets
+    for (int off : grid.offset) {
+      auto [it, fresh] = rows.try_emplace(off - off % hdims[0], std::array<int, 2>{off, off + 1});
+      if (!fresh) it->second = {std::min(it->second[0], off), std::max(it->second[1], off + 1)};
     }
-    for (int r = 0; r < static_cast<int>(grid.row_len.size()); ++r)
-      if (grid.row_len[static_cast<std::size_t>(r)] > 0)
-        grid.rows.push_back({r % grid.dims[1], r / grid.dims[1], grid.row_len[static_cast<std::size_t>(r)]});
+    int valid = 0;
+    for (const auto& [row, span] : rows) {
+      if (!grid.runs.empty()) {
+        auto& last = grid.runs.back();
+        const int merged = span[1] - last[0];
+        if (2 * (valid + span[1] - span[0]) >= merged) {
+          last[1] = merged;
+          valid += span[1] - span[0];
+          continue;
+        }
+      }
+      grid.runs.push_back({span[0], span[1] - span[0]});
+      valid = span[1] - span[0];
+    }
     return grid;
   };
   f_grid_ = make_grid(f_degrees_, false);
   g_grid_ = make_grid(g_degrees_, false);
   h_grid_ = make_grid(h_degrees_, true);
   // Small products: the grids' set-up costs more than the gathers (measured, mu_bench).
-  entries_kernel_ = static_cast<long>(f_size_) * g_size_ < 2048;
+  entries_kernel_ = static_cast<long>(f_size_) * g_size_ < kEntryKernelBelow;
 }
 
-void BernsteinProduct::multiply_add_grid(const double* f, const double* g, double scale,
-                                         double* h) const {
-  thread_local std::vector<double> gs, acc;
-  const auto& gd = g_grid_.dims;
-  const auto& hd = h_grid_.dims;
-  gs.assign(static_cast<std::size_t>(gd[0] * gd[1] * gd[2]), 0.0);
-  acc.assign(static_cast<std::size_t>(hd[0] * hd[1] * hd[2]), 0.0);
-  for (int j = 0; j < g_size_; ++j)
-    gs[static_cast<std::size_t>(g_grid_.cell[static_cast<std::size_t>(j)])] = g_grid_.scale[static_cast<std::size_t>(j)] * g[j];
-  const int f0 = f_grid_.dims[0], f1 = f_grid_.dims[1];
-  const int g0 = gd[0], g1 = gd[1];
-  const int h0 = hd[0], h1 = hd[1];
-  for (int i = 0; i < f_size_; ++i) {
-    const double a = (scale * f_grid_.scale[static_cast<std::size_t>(i)]) * f[i];
+void BernsteinProduct::accumulate_grid(const double* f, const double* g, double scale,
+                                       double* acc) const {
+  // The operand with more coefficients is laid out (scaled, zero-padded) in h's strides
+  // and added, times each scaled coefficient of the other, at that coefficient's cell:
+  // one contiguous loop per run of its grid (the cells between its rows inside a run are
+  // zeros of the padding: a * 0 + x = x exactly). Every cell of a run lies inside h's
+  // grid (i_c + j_c <= h_c - 1 per coordinate).
+  thread_local std::vector<double> pad;
+  const bool swap = f_size_ > g_size_;
+  const Grid& outer = swap ? g_grid_ : f_grid_;
+  const Grid& inner = swap ? f_grid_ : g_grid_;
+  const double* ov = swap ? g : f;
+  const double* iv = swap ? f : g;
+  const int n_outer = swap ? g_size_ : f_size_;
+  const int n_inner = swap ? f_size_ : g_size_;
+  const auto& last = inner.runs.back();
+  pad.assign(static_cast<std::size_t>(last[0] + last[1]), 0.0);
+  for (int j = 0; j < n_inner; ++j)
+    pad[static_cast<std::size_t>(inner.offset[static_cast<std::size_t>(j)])] = inner.scale[static_cast<std::size_t>(j)] * iv[j];
+  const double* __restrict src = pad.data();
+  for (int i = 0; i < n_outer; ++i) {
+    const double a = (scale * outer.scale[static_cast<std::size_t>(i)]) * ov[i];
     if (a == 0) continue;
-    const int cell = f_grid_.cell[static_cast<std::size_t>(i)];
-    const int i0 = cell % f0, i1 = (cell / f0) % f1, i2 = cell / (f0 * f1);
-    double* hbase = acc.data() + i0 + h0 * (i1 + h1 * i2);
-    for (const auto& [j1, j2, len] : g_grid_.rows) {
-      const double* grow = gs.data() + g0 * (j1 + g1 * j2);
-      double* hrow = hbase + h0 * (j1 + h1 * j2);
-      for (int j0 = 0; j0 < len; ++j0) hrow[j0] += a * grow[j0];
+    double* __restrict dst = acc + outer.offset[static_cast<std::size_t>(i)];
+    for (const auto& [start, len] : inner.runs) {
+      double* __restrict d = dst + start;
+      const double* __restrict s = src + start;
+      for (int t = 0; t < len; ++t) d[t] += a * s[t];
     }
   }
+}
+
+void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) const {
+  if (entries_kernel_) {
+    for (const Term& t : terms) multiply_add(t.f, t.g, t.scale, h);
+    return;
+  }
+  thread_local std::vector<double> acc;
+  acc.assign(static_cast<std::size_t>(h_cells_), 0.0);
+  for (const Term& t : terms) accumulate_grid(t.f, t.g, t.scale, acc.data());
   for (int k = 0; k < h_size_; ++k)
-    h[k] += acc[static_cast<std::size_t>(h_grid_.cell[static_cast<std::size_t>(k)])] * h_grid_.scale[static_cast<std::size_t>(k)];
+    h[k] += acc[static_cast<std::size_t>(h_grid_.offset[static_cast<std::size_t>(k)])] * h_grid_.scale[static_cast<std::size_t>(k)];
 }
 
 void BernsteinProduct::multiply_add(const double* f, const double* g, double scale,
                                     double* h) const {
   if (!entries_kernel_) {
-    multiply_add_grid(f, g, scale, h);
+    const Term t{scale, f, g};
+    multiply_add_sum(std::span<const Term>(&t, 1), h);
     return;
   }
   for (const Entry& e2 : entries_[2]) {
@@ -220,11 +269,9 @@ void BernsteinProduct::multiply(const double* f, const double* g, double* h) con
 }
 
 double BernsteinProduct::rounding(int products) const noexcept {
-  // Per term: weight (2u, nearest() may miss by one ulp), two weight products, scale,
-  // f*g and the term product: 8 roundings; then a sum of products * max_terms terms.
-  // Scaled convolution: f scale (2u) times scale and f (2u), g scale (2u)
-  // times g (u), the term (u), h scale (2u) and its product (u), the final sum into h (u):
-  // at most 16 roundings per term, relative to the same convex weights.
+  // Entry kernel, per term: weight (2u, nearest() may miss by one ulp), two weight
+  // products, scale, f*g and the term product: 8 roundings; scaled form: 12 (see the top
+  // of this file); then a sum of products * max_terms terms.
   return rounding_gamma(products * max_terms_ + 16) * 1.01;
 }
 

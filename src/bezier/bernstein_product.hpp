@@ -11,8 +11,9 @@
 // products f_i g_j. Rounding: each weight is rounded to nearest (relative u), the tensor
 // weight is a product of at most three (2 more roundings), times scale, times f_i g_j
 // (2 more) and summed with the other terms: |computed - exact| <= rounding(k) * sum over
-// the k accumulated products of |scale| max|f| max|g|  (Higham, §3.1). The product is
-// computed as the equivalent scaled convolution (at most 16 roundings per term).
+// the k accumulated products of |scale| max|f| max|g|  (Higham, §3.1). Large products are
+// computed as the equivalent scaled convolution (error model at the top of
+// bernstein_product.cpp; the same bound).
 #include <array>
 #include <span>
 #include <vector>
@@ -49,6 +50,16 @@ class BernsteinProduct {
   void multiply_add(const double* f, const double* g, double scale, double* h) const;
   /// h = f * g.
   void multiply(const double* f, const double* g, double* h) const;
+  /// One term scale * f * g of a sum of products in the same spaces.
+  struct Term {
+    double scale;
+    const double* f;
+    const double* g;
+  };
+  /// h += sum_t scale_t f_t g_t. The scaled convolution keeps the whole sum in scaled form
+  /// and unscales once; rounding(terms.size()) bounds the result as for repeated
+  /// multiply_add.
+  void multiply_add_sum(std::span<const Term> terms, double* h) const;
   /// Choose the per-factor weighted-entry loop (default for small products) or the scaled
   /// convolution (default for large ones); same product within rounding().
   void use_entry_kernel(bool on) noexcept { entries_kernel_ = on; }
@@ -69,17 +80,19 @@ class BernsteinProduct {
   std::vector<Entry> entries_[3];  // per factor; unused factors hold one entry {0,0,0,1}
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
-  // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k.
+  // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k. Every
+  // grid is addressed with the strides of h's grid, so that adding a * (g's grid) at the
+  // cell of f_i is one contiguous loop per plane of g.
   struct Grid {
-    std::array<int, 3> dims{1, 1, 1};
-    std::vector<int> cell;       // grid cell of each coefficient
+    std::vector<int> offset;     // per coefficient: its cell in h's strides
     std::vector<double> scale;   // alpha (f, g) or 1 / alpha (h) per coefficient, rounded
-    std::vector<int> row_len;    // per row (coordinates 1, 2): valid cells along coordinate 0
-    std::vector<std::array<int, 3>> rows;  // the non-empty rows: (coordinate 1, 2, length)
+    std::vector<std::array<int, 2>> runs;  // (offset, length): contiguous runs covering it
   };
   Grid f_grid_, g_grid_, h_grid_;
+  int h_cells_ = 1;  // cells of h's grid
   bool entries_kernel_ = false;  // the weighted-entry loop (small products)
-  void multiply_add_grid(const double* f, const double* g, double scale, double* h) const;
+  // acc (h's grid) += scale * (scaled f) conv (scaled g).
+  void accumulate_grid(const double* f, const double* g, double scale, double* acc) const;
 };
 
 /// The shared table of (f, g); thread-safe, built once per key.

@@ -5,6 +5,7 @@
 
 #include <gmpxx.h>
 
+#include <map>
 #include <random>
 #include <vector>
 
@@ -105,6 +106,105 @@ TEST(MuBernsteinProduct, MatchesExactPointwiseProducts) {
               << "case " << &cs - cases.data() << (entries ? " (entries)" : " (convolution)");
         }
       }
+    }
+  }
+}
+
+// Exact control values of sum_t s_t f_t g_t, independently of the product tables: per
+// factor multi-indices a (of f) and b (of g) give a + b (of h) with the weight
+// C(a) C(b) / C(a + b), C the multinomial (Paper V Prop. 4), all in rationals.
+std::vector<mpq_class> exact_product_sum(const std::vector<FactorDegree>& fd, const std::vector<FactorDegree>& gd,
+                                         const std::vector<double>& scales,
+                                         const std::vector<std::vector<double>>& fs,
+                                         const std::vector<std::vector<double>>& gs) {
+  const auto multinomial = [](const std::array<int, 4>& a) {
+    mpz_class c = factorial(a[0] + a[1] + a[2] + a[3]);
+    for (int v : a) c /= factorial(v);
+    return c;
+  };
+  const auto hd = product_degrees(fd, gd);
+  std::vector<std::vector<std::array<int, 4>>> fi, gi;
+  std::vector<std::map<std::array<int, 4>, int>> hi;
+  for (std::size_t f = 0; f < fd.size(); ++f) {
+    fi.push_back(simplex_multi_indices(fd[f].dim, fd[f].degree));
+    gi.push_back(simplex_multi_indices(gd[f].dim, gd[f].degree));
+    std::map<std::array<int, 4>, int> m;
+    const auto h = simplex_multi_indices(hd[f].dim, hd[f].degree);
+    for (std::size_t k = 0; k < h.size(); ++k) m[h[k]] = static_cast<int>(k);
+    hi.push_back(m);
+  }
+  std::vector<mpq_class> out(static_cast<std::size_t>(bernstein_space_size(hd)), mpq_class(0));
+  for (std::size_t i = 0; i < fs[0].size(); ++i)
+    for (std::size_t j = 0; j < gs[0].size(); ++j) {
+      std::size_t ri = i, rj = j, k = 0, stride = 1;
+      mpq_class w = 1;
+      for (std::size_t f = 0; f < fd.size(); ++f) {
+        const auto& a = fi[f][ri % fi[f].size()];
+        const auto& b = gi[f][rj % gi[f].size()];
+        ri /= fi[f].size();
+        rj /= gi[f].size();
+        std::array<int, 4> c{};
+        for (std::size_t x = 0; x < 4; ++x) c[x] = a[x] + b[x];
+        w *= mpq_class(multinomial(a) * multinomial(b), multinomial(c));
+        k += stride * static_cast<std::size_t>(hi[f].at(c));
+        stride *= hi[f].size();
+      }
+      for (std::size_t t = 0; t < scales.size(); ++t)
+        out[k] += w * mpq_class(scales[t]) * mpq_class(fs[t][i]) * mpq_class(gs[t][j]);
+    }
+  return out;
+}
+
+TEST(MuBernsteinProduct, SumsOfProductsMatchExactCoefficients) {
+  // Both kernels, coefficient by coefficient against exact rationals, for sums of three
+  // products (one scaled accumulation, unscaled once): grids where the larger operand is
+  // f or g, whole-plane runs (tensor factors) and row runs (simplices).
+  const std::vector<Case> cases{
+      {{{1, 4}, {1, 4}, {1, 4}}, {{1, 2}, {1, 2}, {1, 2}}},
+      {{{1, 2}, {1, 2}, {1, 2}}, {{1, 6}, {1, 6}, {1, 6}}},
+      {{{3, 4}}, {{3, 2}}},
+      {{{3, 2}}, {{3, 5}}},
+      {{{2, 4}, {1, 3}}, {{2, 2}, {1, 1}}},
+      {{{2, 6}}, {{2, 6}}},
+      {{{1, 6}, {1, 6}}, {{1, 3}, {1, 3}}},
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const std::vector<double> scales{1.0, -0.5, 3.25};
+  for (const Case& cs : cases) {
+    for (const bool entries : {false, true}) {
+      BernsteinProduct table(cs.f, cs.g);
+      table.use_entry_kernel(entries);
+      std::vector<std::vector<double>> fs(3), gs(3);
+      double mag = 0;
+      for (std::size_t t = 0; t < 3; ++t) {
+        double fm = 0, gm = 0;
+        fs[t].resize(static_cast<std::size_t>(table.f_size()));
+        gs[t].resize(static_cast<std::size_t>(table.g_size()));
+        // Mixed magnitudes and some exact zeros (skipped by the convolution's outer loop).
+        for (double& v : fs[t]) fm = std::max(fm, std::abs(v = (u(rng) > 0.8 ? 0.0 : u(rng) * std::ldexp(1.0, static_cast<int>(8 * u(rng))))));
+        for (double& v : gs[t]) gm = std::max(gm, std::abs(v = u(rng) * 1e-3));
+        mag += std::abs(scales[t]) * fm * gm;
+      }
+      const std::vector<BernsteinProduct::Term> terms{{scales[0], fs[0].data(), gs[0].data()},
+                                                      {scales[1], fs[1].data(), gs[1].data()},
+                                                      {scales[2], fs[2].data(), gs[2].data()}};
+      std::vector<double> h(static_cast<std::size_t>(table.h_size()), 0.0);
+      table.multiply_add_sum(terms, h.data());
+      const auto want = exact_product_sum(cs.f, cs.g, scales, fs, gs);
+      const double bound = table.rounding(3) * mag;
+      double worst = 0;
+      for (std::size_t k = 0; k < h.size(); ++k) {
+        const double diff = mpq_class(abs(mpq_class(mpq_class(h[k]) - want[k]))).get_d();
+        worst = std::max(worst, diff);
+        EXPECT_LE(diff, bound) << "case " << &cs - cases.data() << " k " << k << (entries ? " (entries)" : " (convolution)");
+      }
+      // The bound is small enough to mean something (about 1e-14 relative).
+      EXPECT_LT(bound, 1e-12 * mag) << "case " << &cs - cases.data();
+      // Same sum as three separate products, within both rounding bounds.
+      std::vector<double> h3(h.size(), 0.0);
+      for (const auto& t : terms) table.multiply_add(t.f, t.g, t.scale, h3.data());
+      for (std::size_t k = 0; k < h.size(); ++k) EXPECT_NEAR(h[k], h3[k], 2 * bound);
     }
   }
 }

@@ -1,0 +1,119 @@
+// Closed-form bounds of mu for constant W (see mu_constant.hpp for the method).
+#include "analysis/mu_constant.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "analysis/outward_rounding.hpp"
+
+namespace quadval {
+namespace {
+
+thread_local bool use_constant_path = true;
+
+// Rounding margin of the short sums and products below (at most a dozen operations
+// each), relative to the sum of the absolute values of their terms.
+double margin() { return rounding_gamma(16); }
+
+template <int D>
+double ratio_lower(const Eigen::Matrix<double, 3, D>& w, double delta) {
+  const Eigen::Matrix<double, D, D> m = w.transpose() * w;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig(m);
+  if (eig.info() != Eigen::Success) return 0;
+  const Eigen::Matrix<double, D, D>& v = eig.eigenvectors();
+  if (!v.allFinite()) return 0;
+  const double g = margin();
+  // eps >= max_i sum_j |(V^T V - I)_ij|: entry errors gamma * sum_k |V_ki V_kj|.
+  double eps = 0;
+  for (int i = 0; i < D; ++i) {
+    double row = 0;
+    for (int j = 0; j < D; ++j) {
+      double s = 0, mag = 0;
+      for (int k = 0; k < D; ++k) {
+        s += v(k, i) * v(k, j);
+        mag += std::abs(v(k, i) * v(k, j));
+      }
+      row += std::abs(i == j ? s - 1 : s) + g * (mag + 1);
+    }
+    eps = std::max(eps, row * (1 + g));
+  }
+  if (!(eps < 0.5)) return 0;
+  // Y = W V enclosed: |Y_exact - y| <= r (delta * sum_k |V_kj| for W's uncertainty plus
+  // the rounding of the computed sum).
+  Eigen::Matrix<double, 3, D> y, r;
+  for (int c = 0; c < 3; ++c)
+    for (int j = 0; j < D; ++j) {
+      double s = 0, mag = 0, vs = 0;
+      for (int k = 0; k < D; ++k) {
+        s += w(c, k) * v(k, j);
+        mag += std::abs(w(c, k) * v(k, j));
+        vs += std::abs(v(k, j));
+      }
+      y(c, j) = s;
+      r(c, j) = (delta * vs + g * mag) * (1 + g);
+    }
+  // Gershgorin on B = Y^T Y over the enclosure.
+  double b_lo = std::numeric_limits<double>::infinity(), b_hi = 0;
+  for (int i = 0; i < D; ++i) {
+    double d_lo = 0, d_hi = 0, off = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double a = std::abs(y(c, i));
+      const double lo = std::max(0.0, next_down(a - r(c, i)));
+      const double hi = next_up(a + r(c, i));
+      d_lo += lo * lo;
+      d_hi += hi * hi;
+    }
+    for (int j = 0; j < D; ++j) {
+      if (j == i) continue;
+      double s = 0, pert = 0, mag = 0;
+      for (int c = 0; c < 3; ++c) {
+        s += y(c, i) * y(c, j);
+        mag += std::abs(y(c, i) * y(c, j));
+        pert += r(c, i) * std::abs(y(c, j)) + std::abs(y(c, i)) * r(c, j) + r(c, i) * r(c, j);
+      }
+      off += (std::abs(s) + pert + g * mag) * (1 + g);
+    }
+    b_lo = std::min(b_lo, next_down(d_lo * (1 - g) - off * (1 + g)));
+    b_hi = std::max(b_hi, next_up(d_hi * (1 + g) + off * (1 + g)));
+  }
+  if (!(b_lo > 0) || !std::isfinite(b_hi)) return 0;
+  const double l_min = next_down(b_lo / next_up(1 + eps));
+  const double l_max = next_up(b_hi / next_down(1 - eps));
+  return std::clamp(next_down(l_min / l_max), 0.0, 1.0);
+}
+
+}  // namespace
+
+void mu_use_constant_path(bool on) noexcept { use_constant_path = on; }
+bool mu_constant_path_enabled() noexcept { return use_constant_path; }
+
+double constant_w_radius(const MuSpace& space, const double* w, double err) {
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  double dev = 0;
+  for (int j = 0; j < space.dim() * 3; ++j) {
+    const double* p = w + static_cast<std::size_t>(j) * ws;
+    // |w_k - w_0| rounded to nearest is within one ulp: next_up covers it.
+    for (std::size_t k = 1; k < ws; ++k) dev = std::max(dev, next_up(std::abs(p[k] - p[0])));
+  }
+  return next_up(err + dev);
+}
+
+double constant_ratio_lower(const MuSpace& space, const double* w, double delta) {
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  const auto at = [&](int j, int c) { return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws]; };
+  if (space.dim() == 2) {
+    Eigen::Matrix<double, 3, 2> wm;
+    for (int j = 0; j < 2; ++j)
+      for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
+    return ratio_lower<2>(wm, delta);
+  }
+  Eigen::Matrix<double, 3, 3> wm;
+  for (int j = 0; j < 3; ++j)
+    for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
+  return ratio_lower<3>(wm, delta);
+}
+
+}  // namespace quadval

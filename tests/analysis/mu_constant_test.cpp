@@ -1,0 +1,125 @@
+// The closed form of mu for constant W (src/analysis/mu_constant.hpp) against Eigen's SVD
+// (the exact singular values of affine elements and of sampled matrices of the box) and
+// against the general path of mu_bounds on thousands of random affine elements.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <random>
+
+#include "analysis/mu_constant.hpp"
+#include "analysis/mu_space.hpp"
+#include "mu_test_util.hpp"
+#include "quadval/element_type.hpp"
+#include "quadval/mu_bounds.hpp"
+
+namespace quadval {
+namespace {
+
+double svd_ratio(const Eigen::MatrixXd& w) {
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(w);
+  const auto s = svd.singularValues();
+  return s(s.size() - 1) / s(0);
+}
+
+// Control values of a constant W in the layout of MuMetric::lower_bound.
+std::vector<double> constant_controls(const MuSpace& space, const Eigen::MatrixXd& w) {
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  std::vector<double> out(static_cast<std::size_t>(space.dim() * 3) * ws);
+  for (int j = 0; j < space.dim(); ++j)
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t k = 0; k < ws; ++k) out[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + k] = w(c, j);
+  return out;
+}
+
+TEST(MuConstant, RatioBoundEnclosesSvdOfEveryMatrixOfTheBox) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const int id : {2, 4}) {  // triangle 3 (3 x 2 W), tetrahedron 4 (3 x 3 W)
+    const MuSpace& space = mu_space(*find_element_type(id));
+    const int dim = space.dim();
+    for (int trial = 0; trial < 2000; ++trial) {
+      Eigen::MatrixXd w(3, dim);
+      for (int c = 0; c < 3; ++c)
+        for (int j = 0; j < dim; ++j) w(c, j) = u(rng);
+      if (trial % 3 == 0) w.col(0) = w.col(dim - 1) * (1 + 1e-3 * u(rng)) + 1e-3 * Eigen::Vector3d::Random();  // near-degenerate
+      if (trial % 5 == 0) w = w.householderQr().householderQ() * Eigen::MatrixXd::Identity(3, dim) * 2.0;  // ideal: R = 1
+      const double delta = trial % 2 == 0 ? 0.0 : 1e-6;
+      const auto ctrl = constant_controls(space, w);
+      const double lo = constant_ratio_lower(space, ctrl.data(), delta);
+      const double exact = svd_ratio(w);
+      ASSERT_LE(std::sqrt(lo), exact * (1 + 1e-14)) << "trial " << trial;
+      // Tight: the closed form loses only rounding (relative, amplified near degeneracy)
+      // and delta.
+      if (exact > 1e-3) EXPECT_GE(std::sqrt(lo), exact * (1 - 1e-8) - 50 * delta / exact) << "trial " << trial;
+      // Matrices of the box (its corners and random points) are never below the bound.
+      for (int s = 0; s < 8 && delta > 0; ++s) {
+        Eigen::MatrixXd p = w;
+        for (int c = 0; c < 3; ++c)
+          for (int j = 0; j < dim; ++j) p(c, j) += delta * (s < 4 ? (u(rng) > 0 ? 1.0 : -1.0) : u(rng));
+        ASSERT_LE(lo, svd_ratio(p) * svd_ratio(p) * (1 + 1e-14)) << "trial " << trial;
+      }
+    }
+  }
+}
+
+TEST(MuConstant, AffineElementsMatchSvdAndTheGeneralPath) {
+  // Straight simplices, parallelograms, parallelepipeds, prisms of every order: W is
+  // constant, mu = sigma_min(A) / sigma_max(A) of the affine map (A's first two columns in
+  // 2D). The fast path must enclose it within the tolerance and agree with the general
+  // path (constant path off).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  QualityOptions opt;
+  opt.abs_tol = 1e-6;
+  int fast = 0;
+  for (const int id : {2, 9, 3, 10, 4, 11, 6, 5, 12}) {
+    const ElementType& type = *find_element_type(id);
+    const int count = type.order == 1 ? 1000 : 150;
+    for (int e = 0; e < count; ++e) {
+      Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) a(i, j) += 0.6 * u(rng);
+      if (type.dim == 2) a(0, 2) = a(1, 2) = a(2, 0) = a(2, 1) = 0, a(2, 2) = 1;
+      if (a.determinant() < 0.05) continue;  // valid, orientation kept
+      const Eigen::Vector3d b(u(rng), u(rng), type.dim == 2 ? 0.0 : u(rng));
+      const auto x = test::affine_ideal_element(type, a, b);
+      const double exact = svd_ratio(type.dim == 2 ? Eigen::MatrixXd(a.leftCols(2)) : Eigen::MatrixXd(a));
+      mu_use_constant_path(true);
+      const QualityBounds q = mu_bounds(type, x, opt, true);
+      mu_use_constant_path(false);
+      const QualityBounds g = mu_bounds(type, x, opt, true);
+      mu_use_constant_path(true);
+      ASSERT_TRUE(q.tolerance_met && g.tolerance_met) << type.name << " element " << e;
+      EXPECT_LE(q.lower, exact * (1 + 1e-14)) << type.name << " element " << e;
+      EXPECT_GE(q.upper, exact * (1 - 1e-14)) << type.name << " element " << e;
+      EXPECT_LE(q.lower, g.upper) << type.name << " element " << e;
+      EXPECT_LE(g.lower, q.upper) << type.name << " element " << e;
+      fast += q.subdivisions == 0 && q.upper - q.lower < 1e-9;
+    }
+  }
+  // The closed form settled (nearly) all of them, to far better than the tolerance.
+  EXPECT_GT(fast, 4000);
+}
+
+TEST(MuConstant, CurvedElementsAreNotTakenForConstant) {
+  // Elements with one edge node moved: W varies, the general path answers (the same
+  // bounds with the constant path on and off; the closed form's would be far narrower).
+  QualityOptions opt;
+  opt.abs_tol = 1e-6;
+  for (const int id : {11, 10, 12}) {
+    const ElementType& type = *find_element_type(id);
+    auto x = test::affine_ideal_element(type, Eigen::Matrix3d::Identity(), Eigen::Vector3d::Zero());
+    x[3 * static_cast<std::size_t>(family_num_vertices(type.family)) + 1] += 0.05;
+    mu_use_constant_path(false);
+    const QualityBounds g = mu_bounds(type, x, opt, true);
+    mu_use_constant_path(true);
+    const QualityBounds q = mu_bounds(type, x, opt, true);
+    EXPECT_EQ(q.lower, g.lower) << type.name;
+    EXPECT_EQ(q.upper, g.upper) << type.name;
+    EXPECT_LT(q.upper, 1.0) << type.name;
+  }
+}
+
+}  // namespace
+}  // namespace quadval
