@@ -112,6 +112,11 @@ class BernsteinSimplex {
   std::vector<double> subdivision_, subdivision_t_;  // num_children blocks of size*size
 };
 
+/// Multi-indices of the Bernstein polynomials of degree n on the d-simplex (d = 0..3), in
+/// the order of BernsteinSimplex::multi_indices(), without building a factor: the last
+/// barycentric index slowest, alpha_0 = n - the others; d = 0 gives the single {n, 0, 0, 0}.
+std::vector<std::array<int, 4>> simplex_multi_indices(int dim, int degree);
+
 /// The shared factor of (dim, degree); thread-safe, built once.
 const BernsteinSimplex& bernstein_simplex(int dim, int degree);
 

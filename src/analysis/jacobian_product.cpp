@@ -26,6 +26,7 @@
 #include <tuple>
 
 #include "analysis/exact_inverse.hpp"
+#include "analysis/factor_shapes.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
@@ -39,40 +40,6 @@ namespace {
 using MultiIndex = std::array<int, 4>;
 constexpr double kUnit = 0x1p-53;
 
-struct FactorShape {
-  int dim;        // 1, 2, 3
-  int first;      // first Gmsh coordinate it covers
-  bool interval;  // a [-1, 1] Gmsh direction mapped to [0, 1]
-};
-
-std::vector<FactorShape> factor_shapes(ElementFamily f) {
-  switch (f) {
-    case ElementFamily::line: return {{1, 0, true}};
-    case ElementFamily::triangle: return {{2, 0, false}};
-    case ElementFamily::quadrangle: return {{1, 0, true}, {1, 1, true}};
-    case ElementFamily::tetrahedron: return {{3, 0, false}};
-    case ElementFamily::prism: return {{2, 0, false}, {1, 2, true}};
-    case ElementFamily::hexahedron: return {{1, 0, true}, {1, 1, true}, {1, 2, true}};
-    default: return {};
-  }
-}
-
-// All alpha with |alpha| = n in d+1 components, component 1 fastest (BernsteinSimplex order).
-std::vector<MultiIndex> simplex_indices(int d, int n) {
-  std::vector<MultiIndex> out;
-  if (d == 0) return {{n, 0, 0, 0}};
-  if (d == 1) {
-    for (int i = 0; i <= n; ++i) out.push_back({n - i, i, 0, 0});
-  } else if (d == 2) {
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i + j <= n; ++i) out.push_back({n - i - j, i, j, 0});
-  } else {
-    for (int k = 0; k <= n; ++k)
-      for (int j = 0; j + k <= n; ++j)
-        for (int i = 0; i + j + k <= n; ++i) out.push_back({n - i - j - k, i, j, k});
-  }
-  return out;
-}
 
 int index_of(const std::vector<MultiIndex>& list, const MultiIndex& a) {
   const auto it = std::find(list.begin(), list.end(), a);
@@ -153,7 +120,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
     s.total = 1;
     for (int h = 0; h < 3; ++h) {
       const auto hs = static_cast<std::size_t>(h);
-      s.size[hs] = h < num_factors_ ? static_cast<int>(simplex_indices(factor_dim_[hs], degree[hs]).size()) : 1;
+      s.size[hs] = h < num_factors_ ? static_cast<int>(simplex_multi_indices(factor_dim_[hs], degree[hs]).size()) : 1;
       s.total *= s.size[hs];
     }
     return s;
@@ -173,7 +140,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
       const int d = factor_dim_[hs];
       const BernsteinSimplex& geo = bernstein_simplex(d, p);
       const auto& t = geo.exact().to_bezier;
-      const auto lat = simplex_indices(d, p);
+      const auto lat = simplex_multi_indices(d, p);
       const auto ls = lat.size();
       auto& m = factor_matrix_[cs][hs];
       if (h != f) {
@@ -181,7 +148,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
         for (std::size_t a = 0; a < ls; ++a)
           for (std::size_t l = 0; l < ls; ++l) m[a * ls + l] = multinomial(lat[a]) * t[a * ls + l];
       } else {
-        const auto rows = simplex_indices(d, p - 1);
+        const auto rows = simplex_multi_indices(d, p - 1);
         m.resize(rows.size() * ls);
         const mpq_class scale = factor_interval_[hs] ? frac(p, 2) : mpq_class(p);
         const int local = direction_local_[cs];
@@ -203,7 +170,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
       int rest = k;
       for (int h = 0; h < num_factors_; ++h) {
         const auto hs = static_cast<std::size_t>(h);
-        const auto idx = simplex_indices(factor_dim_[hs], deg[hs]);
+        const auto idx = simplex_multi_indices(factor_dim_[hs], deg[hs]);
         w *= multinomial(idx[static_cast<std::size_t>(rest % deriv_space_[cs].size[hs])]);
         rest /= deriv_space_[cs].size[hs];
       }
@@ -263,7 +230,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
           sum += a[static_cast<std::size_t>(c + 1)];
         }
         a[0] = p - sum;
-        l += stride * index_of(simplex_indices(factor_dim_[hs], p), a);
+        l += stride * index_of(simplex_multi_indices(factor_dim_[hs], p), a);
         stride *= lattice_.size[hs];
       }
       lattice_of_node_[i] = l;
@@ -288,8 +255,8 @@ JacobianProduct::Product JacobianProduct::make_product(const Space& a, const Spa
       continue;
     }
     const int d = factor_dim_[hs];
-    const auto ia = simplex_indices(d, a.degree[hs]), ib = simplex_indices(d, b.degree[hs]),
-               ic = simplex_indices(d, c.degree[hs]);
+    const auto ia = simplex_multi_indices(d, a.degree[hs]), ib = simplex_multi_indices(d, b.degree[hs]),
+               ic = simplex_multi_indices(d, c.degree[hs]);
     std::vector<int> terms(ic.size(), 0);
     for (std::size_t x = 0; x < ia.size(); ++x)
       for (std::size_t y = 0; y < ib.size(); ++y) {
@@ -372,7 +339,7 @@ void JacobianProduct::build_map(SampleMap which) {
         std::size_t rest = l;
         for (int h = 0; h < num_factors_; ++h) {
           const auto hs = static_cast<std::size_t>(h);
-          const auto idx = simplex_indices(factor_dim_[hs], p);
+          const auto idx = simplex_multi_indices(factor_dim_[hs], p);
           const MultiIndex& a = idx[rest % idx.size()];
           rest /= idx.size();
           value *= frac(a[static_cast<std::size_t>(corner[hs])], p);
@@ -422,7 +389,7 @@ void JacobianProduct::build_map(SampleMap which) {
       std::size_t rest = l;
       for (int h = 0; h < num_factors_; ++h) {
         const auto hs = static_cast<std::size_t>(h);
-        const auto idx = simplex_indices(factor_dim_[hs], p);
+        const auto idx = simplex_multi_indices(factor_dim_[hs], p);
         const MultiIndex& a = idx[rest % idx.size()];
         rest /= idx.size();
         for (int c = 0; c < factor_dim_[hs]; ++c)

@@ -16,6 +16,7 @@
 #include <stdexcept>
 
 #include "analysis/exact_inverse.hpp"
+#include "analysis/factor_shapes.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -25,25 +26,6 @@ namespace {
 
 using MultiIndex = std::array<int, 4>;
 constexpr double kUnit = std::numeric_limits<double>::epsilon() / 2;
-
-// One factor of the element's reference domain.
-struct FactorShape {
-  int dim;        // 1, 2, 3
-  int first;      // first Gmsh coordinate it covers
-  bool interval;  // a [-1, 1] Gmsh direction mapped to [0, 1] (lines only)
-};
-
-std::vector<FactorShape> factor_shapes(ElementFamily f) {
-  switch (f) {
-    case ElementFamily::line: return {{1, 0, true}};
-    case ElementFamily::triangle: return {{2, 0, false}};
-    case ElementFamily::quadrangle: return {{1, 0, true}, {1, 1, true}};
-    case ElementFamily::tetrahedron: return {{3, 0, false}};
-    case ElementFamily::prism: return {{2, 0, false}, {1, 2, true}};
-    case ElementFamily::hexahedron: return {{1, 0, true}, {1, 1, true}, {1, 2, true}};
-    default: return {};
-  }
-}
 
 // n / d in lowest terms (gmpxx does not reduce a num/den pair, and GMP needs it reduced).
 mpq_class frac(long n, long d) {

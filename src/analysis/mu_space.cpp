@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "analysis/exact_inverse.hpp"
+#include "analysis/factor_shapes.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
@@ -22,23 +23,6 @@ namespace {
 
 using MultiIndex = std::array<int, 4>;
 using Matrix = std::vector<mpq_class>;  // row-major
-
-struct FactorShape {
-  int dim;        // 1, 2, 3
-  int first;      // first Gmsh coordinate it covers
-  bool interval;  // a [-1, 1] Gmsh direction mapped to [0, 1]
-};
-
-std::vector<FactorShape> factor_shapes(ElementFamily f) {
-  switch (f) {
-    case ElementFamily::triangle: return {{2, 0, false}};
-    case ElementFamily::quadrangle: return {{1, 0, true}, {1, 1, true}};
-    case ElementFamily::tetrahedron: return {{3, 0, false}};
-    case ElementFamily::prism: return {{2, 0, false}, {1, 2, true}};
-    case ElementFamily::hexahedron: return {{1, 0, true}, {1, 1, true}, {1, 2, true}};
-    default: return {};
-  }
-}
 
 bool simplicial(ElementFamily f) {
   return f == ElementFamily::triangle || f == ElementFamily::tetrahedron;

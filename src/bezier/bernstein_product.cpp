@@ -65,23 +65,6 @@ constexpr long kEntryKernelBelow = 2048;
 
 }  // namespace
 
-std::vector<std::array<int, 4>> simplex_multi_indices(int d, int n) {
-  // Same enumeration as BernsteinSimplex (src/bezier/bernstein_simplex.cpp): the last
-  // barycentric index slowest, alpha_0 = n - the others.
-  std::vector<MultiIndex> out;
-  if (d == 1) {
-    for (int i = 0; i <= n; ++i) out.push_back({n - i, i, 0, 0});
-  } else if (d == 2) {
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i + j <= n; ++i) out.push_back({n - i - j, i, j, 0});
-  } else {
-    for (int k = 0; k <= n; ++k)
-      for (int j = 0; j + k <= n; ++j)
-        for (int i = 0; i + j + k <= n; ++i) out.push_back({n - i - j - k, i, j, k});
-  }
-  return out;
-}
-
 int bernstein_space_size(std::span<const FactorDegree> factors) noexcept {
   int s = 1;
   for (const FactorDegree& f : factors) s *= binomial_size(f.dim, f.degree);

@@ -22,10 +22,6 @@
 
 namespace quadval {
 
-/// Multi-indices of the Bernstein polynomials of degree n on the d-simplex, in the order
-/// of BernsteinSimplex::multi_indices() (without building the factor's matrices).
-std::vector<std::array<int, 4>> simplex_multi_indices(int dim, int degree);
-
 /// Number of coefficients of a tensor-product space: prod C(n_f + d_f, d_f).
 int bernstein_space_size(std::span<const FactorDegree> factors) noexcept;
 

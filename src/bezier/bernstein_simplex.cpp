@@ -21,21 +21,6 @@ namespace {
 
 using MultiIndex = std::array<int, 4>;
 
-// All alpha with |alpha| = n in d+1 components, component 1 varying fastest.
-std::vector<MultiIndex> enumerate_multi_indices(int d, int n) {
-  std::vector<MultiIndex> out;
-  if (d == 1) {
-    for (int i = 0; i <= n; ++i) out.push_back({n - i, i, 0, 0});
-  } else if (d == 2) {
-    for (int j = 0; j <= n; ++j)
-      for (int i = 0; i + j <= n; ++i) out.push_back({n - i - j, i, j, 0});
-  } else {
-    for (int k = 0; k <= n; ++k)
-      for (int j = 0; j + k <= n; ++j)
-        for (int i = 0; i + j + k <= n; ++i) out.push_back({n - i - j - k, i, j, k});
-  }
-  return out;
-}
 
 mpz_class factorial(int n) {
   mpz_class f = 1;
@@ -172,10 +157,27 @@ std::vector<std::array<MultiIndex, 4>> midpoint_children(int d) {
 
 }  // namespace
 
+std::vector<std::array<int, 4>> simplex_multi_indices(int d, int n) {
+  std::vector<std::array<int, 4>> out;
+  if (d == 0) {
+    out.push_back({n, 0, 0, 0});
+  } else if (d == 1) {
+    for (int i = 0; i <= n; ++i) out.push_back({n - i, i, 0, 0});
+  } else if (d == 2) {
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i + j <= n; ++i) out.push_back({n - i - j, i, j, 0});
+  } else {
+    for (int k = 0; k <= n; ++k)
+      for (int j = 0; j + k <= n; ++j)
+        for (int i = 0; i + j + k <= n; ++i) out.push_back({n - i - j - k, i, j, k});
+  }
+  return out;
+}
+
 BernsteinSimplex::BernsteinSimplex(int dim, int degree)
     : dim_(dim), degree_(degree), exact_(std::make_unique<Exact>()) {
   QV_ASSERT(dim >= 1 && dim <= 3 && degree >= 0, "dim " << dim << " degree " << degree);
-  alphas_ = enumerate_multi_indices(dim, degree);
+  alphas_ = simplex_multi_indices(dim, degree);
   const int s = size();
   QV_ASSERT(s <= 500, "Bernstein factor too large: " << s);
   const auto n_sz = static_cast<std::size_t>(s);
