@@ -46,4 +46,10 @@ inline CliRun run_cli(const std::string& args) {
   return r;
 }
 
+/// The whole content of a file (empty when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 }  // namespace quadval::testing_cli

@@ -9,6 +9,7 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {

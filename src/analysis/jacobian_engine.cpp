@@ -14,6 +14,7 @@
 
 #include "bezier/bezier_exact.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -72,20 +73,6 @@ std::vector<mpq_class> exact_subdivide(const BezierBasis& b, const std::vector<m
 }
 
 }  // namespace
-
-double round_down(const mpq_class& q) {
-  double d = q.get_d();
-  while (mpq_class(d) > q) d = down(d);
-  while (mpq_class(up(d)) <= q) d = up(d);
-  return d;
-}
-
-double round_up(const mpq_class& q) {
-  double d = q.get_d();
-  while (mpq_class(d) < q) d = up(d);
-  while (mpq_class(down(d)) >= q) d = down(d);
-  return d;
-}
 
 MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, double err,
                              bool need_sign, double tol, int max_subdivisions,

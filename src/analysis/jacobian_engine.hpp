@@ -94,8 +94,5 @@ inline void jacobian_coefficients(const JacobianSpace& space, const double* node
 DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,
                                  const JacobianBounds& jb, BoundsWorkspace::Impl& ws);
 
-/// The largest double <= q, and the smallest double >= q.
-double round_down(const mpq_class& q);
-double round_up(const mpq_class& q);
 
 }  // namespace quadval

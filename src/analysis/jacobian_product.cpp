@@ -30,6 +30,7 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -63,24 +64,6 @@ mpq_class frac(long n, long d) {
   mpq_class q(n, d);
   q.canonicalize();
   return q;
-}
-
-// The double nearest to q.
-double nearest(const mpq_class& q) {
-  const double d = q.get_d();  // truncated toward zero
-  double best = d;
-  mpq_class err = abs(mpq_class(d) - q);
-  for (double c : {std::nextafter(d, INFINITY), std::nextafter(d, -INFINITY)}) {
-    const mpq_class e = abs(mpq_class(c) - q);
-    if (e < err) err = e, best = c;
-  }
-  return best;
-}
-
-double round_up(const mpq_class& q) {
-  double d = q.get_d();
-  while (mpq_class(d) < q) d = std::nextafter(d, INFINITY);
-  return d;
 }
 
 // A Gmsh reference coordinate snapped to the order-p lattice (numerator over p).
@@ -174,7 +157,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
         w *= multinomial(idx[static_cast<std::size_t>(rest % deriv_space_[cs].size[hs])]);
         rest /= deriv_space_[cs].size[hs];
       }
-      inv[static_cast<std::size_t>(k)] = nearest(mpq_class(1) / mpq_class(w));
+      inv[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(w));
     }
   }
 
@@ -195,7 +178,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
     for (int h = 0; h < num_factors_; ++h)
       w *= multinomial(basis.factors()[static_cast<std::size_t>(h)]->multi_indices()[static_cast<std::size_t>(basis.factor_index(k, h))]);
     mult_[static_cast<std::size_t>(k)] = w;
-    inv_mult_[static_cast<std::size_t>(k)] = nearest(mpq_class(1) / mpq_class(w));
+    inv_mult_[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(w));
   }
 
   // The convolutions, and the rounding constant of the model above.
@@ -416,7 +399,7 @@ void JacobianProduct::build_map(SampleMap which) {
     auto& g = map.matrix[cs];
     g.assign(rows * n, 0.0);
     const auto store = [&](std::size_t k, std::size_t i, const mpq_class& q) {
-      g[k * n + i] = nearest(q);
+      g[k * n + i] = nearest_double(q);
       row_abs[k] += abs(q);
     };
     if (map.to_lattice.empty()) {

@@ -17,6 +17,7 @@
 
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -90,8 +91,6 @@ int snap(double x, int p, bool interval) {
   QV_ASSERT(std::abs(t - m) < 1e-9, "reference node " << x << " is off the order-" << p << " lattice");
   return static_cast<int>(m);
 }
-
-double nearest(const mpq_class& q) { return q.get_d() + (mpq_class(q - mpq_class(q.get_d()))).get_d(); }
 
 // The exact sample points of the basis in Gmsh reference coordinates.
 std::vector<std::array<mpq_class, 3>> exact_sample_points(const BezierBasis& b,
@@ -313,8 +312,8 @@ JacobianSpace::JacobianSpace(const ElementType& type)
         // rounded factor tables
         std::vector<std::vector<double>> val(shapes.size()), der(shapes.size());
         for (std::size_t h = 0; h < shapes.size(); ++h) {
-          for (const auto& q : fm[h].value) val[h].push_back(nearest(q));
-          for (const auto& q : fm[h].deriv[h == f ? c : 0]) der[h].push_back(nearest(q));
+          for (const auto& q : fm[h].value) val[h].push_back(nearest_double(q));
+          for (const auto& q : fm[h].deriv[h == f ? c : 0]) der[h].push_back(nearest_double(q));
         }
         for (std::size_t k = 0; k < s; ++k)
           for (std::size_t i = 0; i < n; ++i) {
@@ -329,12 +328,12 @@ JacobianSpace::JacobianSpace(const ElementType& type)
           }
       }
     }
-    gradient_rel_error_ = 5 * kUnit;  // 2.5u, doubled: nearest() may miss by one ulp
+    gradient_rel_error_ = 5 * kUnit;  // 2.5u, doubled as a margin (nearest_double is within u)
   } else {
     build_exact();
     for (int c = 0; c < dim_; ++c) {
       grad_[c].resize(s * n);
-      for (std::size_t i = 0; i < s * n; ++i) grad_[c][i] = nearest(exact_[c][i]);
+      for (std::size_t i = 0; i < s * n; ++i) grad_[c][i] = nearest_double(exact_[c][i]);
     }
     gradient_rel_error_ = 2 * kUnit;
   }
@@ -363,7 +362,7 @@ void JacobianSpace::build_straight() const {
     tensor_gradients(*basis_, shapes, fm, idx, g);
     for (int c = 0; c < dim_; ++c) {
       straight_[c].resize(g[c].size());
-      for (std::size_t i = 0; i < g[c].size(); ++i) straight_[c][i] = nearest(g[c][i]);
+      for (std::size_t i = 0; i < g[c].size(); ++i) straight_[c][i] = nearest_double(g[c][i]);
     }
     straight_rel_error_ = 2 * kUnit;
     const auto nv = static_cast<std::size_t>(num_vertices_);

@@ -14,6 +14,7 @@
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
 #include "bezier/bezier_exact.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -26,11 +27,6 @@ using Matrix = std::vector<mpq_class>;  // row-major
 
 bool simplicial(ElementFamily f) {
   return f == ElementFamily::triangle || f == ElementFamily::tetrahedron;
-}
-
-double nearest(const mpq_class& q) {
-  const double d = q.get_d();
-  return d + mpq_class(q - mpq_class(d)).get_d();
 }
 
 // Numerator m of a Gmsh coordinate on the order-p lattice (m / p in Bézier units).
@@ -280,7 +276,7 @@ MuSpace::MuSpace(const ElementType& type) : type_(&type) {
       for (int f = 0; f < nf; ++f) col = apply_factor(col, sizes, f, maps[static_cast<std::size_t>(f)], rows[static_cast<std::size_t>(f)]);
       QV_ASSERT(col.size() == ws, "derivative map size " << col.size() << " vs " << ws);
       for (std::size_t k = 0; k < ws; ++k) {
-        const double v = nearest(col[k]);
+        const double v = nearest_double(col[k]);
         deriv_[c][k * n + i] = v;
         row_abs[k] += std::abs(v);
       }

@@ -31,6 +31,7 @@
 #include "analysis/exact_inverse.hpp"
 #include "analysis/jacobian_product.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -60,23 +61,6 @@ mpq_class snap(double x, int p, const ElementType& type) {
   mpq_class q(static_cast<long>(m), p);
   q.canonicalize();
   return q;
-}
-
-// The double nearest to q, and the smallest double >= q.
-double nearest(const mpq_class& q) {
-  const double d = q.get_d();
-  double best = d;
-  mpq_class err = abs(mpq_class(d) - q);
-  for (double c : {std::nextafter(d, INFINITY), std::nextafter(d, -INFINITY)}) {
-    const mpq_class e = abs(mpq_class(c) - q);
-    if (e < err) err = e, best = c;
-  }
-  return best;
-}
-double round_up(const mpq_class& q) {
-  double d = q.get_d();
-  while (mpq_class(d) < q) d = std::nextafter(d, INFINITY);
-  return d;
 }
 
 // tau_m(t) = t^m prod_{l = m+1..r} (t - l / r), as coefficients of t^0..t^r.
@@ -270,7 +254,7 @@ void JacobianProduct::init_pyramid() {
     auto& inv = deriv_inv_mult_[cs];
     inv.resize(static_cast<std::size_t>(deriv_space_[cs].total));
     for (int k = 0; k < deriv_space_[cs].total; ++k)
-      inv[static_cast<std::size_t>(k)] = nearest(mpq_class(1) / mpq_class(mult_of(deriv_space_[cs], k)));
+      inv[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(mult_of(deriv_space_[cs], k)));
   }
   const Space jspace = space_of(jdeg);
   QV_ASSERT(jspace.total == basis_->size() && static_cast<int>(basis_->factors().size()) == num_factors_,
@@ -281,7 +265,7 @@ void JacobianProduct::init_pyramid() {
   inv_mult_.resize(mult_.size());
   for (int k = 0; k < jspace.total; ++k) {
     mult_[static_cast<std::size_t>(k)] = mult_of(jspace, k);
-    inv_mult_[static_cast<std::size_t>(k)] = nearest(mpq_class(1) / mpq_class(mult_[static_cast<std::size_t>(k)]));
+    inv_mult_[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(mult_[static_cast<std::size_t>(k)]));
   }
   std::array<int, 3> bc{0, 0, 0};
   for (std::size_t h = 0; h < 3; ++h) bc[h] = deriv_space_[1].degree[h] + deriv_space_[2].degree[h];
@@ -309,7 +293,7 @@ void JacobianProduct::init_pyramid() {
         for (std::size_t j = 0; j < n; ++j) column[j] = sc.coefficients[j * n + i];
         const std::vector<mpq_class> d = pyramid_scaled_derivative(r, c, sc.exponents, column);
         for (std::size_t k = 0; k < rows; ++k) {
-          g[k * n + i] = nearest(d[k]);
+          g[k * n + i] = nearest_double(d[k]);
           row_abs[k] += abs(d[k]);
         }
       }

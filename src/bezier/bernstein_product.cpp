@@ -7,7 +7,7 @@
 //    computed as contiguous runs in h's strides; a sum of products in the same spaces is
 //    accumulated in scaled form and unscaled once (multiply_add_sum).
 // Error model of the scaled form, per term alpha_i alpha_j / alpha_k f_i g_j: alpha_i,
-// alpha_j, 1 / alpha_k each rounded to within one ulp (2u each), scale * alpha_i (u),
+// alpha_j, 1 / alpha_k each rounded to nearest (within u; 2u allowed), scale * alpha_i (u),
 // times f_i (u), alpha_j g_j (u), the term product (u, or none with a fused multiply-add),
 // the unscaling product (u) and the final addition into h (u): at most 12 roundings, so
 // the computed term is the exact convex-weighted term times (1 + theta_12). The k terms
@@ -24,6 +24,7 @@
 #include <mutex>
 #include <tuple>
 
+#include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -46,12 +47,6 @@ mpz_class multinomial(const MultiIndex& a, int dim) {
     den *= factorial(a[static_cast<std::size_t>(c)]);
   }
   return factorial(n) / den;
-}
-
-// The double nearest to q (within one ulp): the truncated value plus its truncated remainder.
-double nearest(const mpq_class& q) {
-  const double d = q.get_d();
-  return d + mpq_class(q - mpq_class(d)).get_d();
 }
 
 int binomial_size(int dim, int degree) {
@@ -110,7 +105,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
         for (std::size_t a = 0; a < 4; ++a) k[a] = fi[i][a] + gi[j][a];
         const int kk = h_index.at(k);
         const mpq_class w(multinomial(fi[i], d) * multinomial(gi[j], d), multinomial(k, d));
-        entries_[fac].push_back({static_cast<int>(i), static_cast<int>(j), kk, nearest(mpq_class(w))});
+        entries_[fac].push_back({static_cast<int>(i), static_cast<int>(j), kk, nearest_double(mpq_class(w))});
         ++terms[static_cast<std::size_t>(kk)];
       }
     int most = 0;
@@ -149,7 +144,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
         for (int k = 1; k <= deg[f].dim; ++k) pos[static_cast<std::size_t>(c++)] = a[static_cast<std::size_t>(k)];
       }
       grid.offset.push_back(pos[0] + hdims[0] * (pos[1] + hdims[1] * pos[2]));
-      grid.scale.push_back(invert ? nearest(mpq_class(mpz_class(1), alpha)) : nearest(mpq_class(alpha)));
+      grid.scale.push_back(invert ? nearest_double(mpq_class(mpz_class(1), alpha)) : nearest_double(mpq_class(alpha)));
     }
     // Runs: the valid cells of a row are a prefix (an index sum <= n per simplex factor);
     // consecutive rows merge into one run while at least half of its cells are valid
@@ -252,7 +247,7 @@ void BernsteinProduct::multiply(const double* f, const double* g, double* h) con
 }
 
 double BernsteinProduct::rounding(int products) const noexcept {
-  // Entry kernel, per term: weight (2u, nearest() may miss by one ulp), two weight
+  // Entry kernel, per term: weight (2u allowed; nearest_double is within u), two weight
   // products, scale, f*g and the term product: 8 roundings; scaled form: 12 (see the top
   // of this file); then a sum of products * max_terms terms.
   return rounding_gamma(products * max_terms_ + 16) * 1.01;

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "bezier/bezier_exact.hpp"
+#include "bezier/rational_rounding.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/error.hpp"
 
@@ -89,30 +90,6 @@ std::vector<mpq_class> collocation(int dim, const std::vector<MultiIndex>& alpha
     }
   }
   return v;
-}
-
-// Rounds up: the smallest double >= q.
-double round_up(const mpq_class& q) {
-  double d = q.get_d();  // truncates toward zero
-  while (mpq_class(d) < q) d = std::nextafter(d, std::numeric_limits<double>::infinity());
-  return d;
-}
-
-// The double nearest to q (ties either way: the error bound uses u, not u/2).
-double nearest(const mpq_class& q) {
-  const double d = q.get_d();
-  const double up = std::nextafter(d, std::numeric_limits<double>::infinity());
-  const double down = std::nextafter(d, -std::numeric_limits<double>::infinity());
-  double best = d;
-  mpq_class err = abs(mpq_class(d) - q);
-  for (double c : {up, down}) {
-    mpq_class e = abs(mpq_class(c) - q);
-    if (e < err) {
-      err = e;
-      best = c;
-    }
-  }
-  return best;
 }
 
 // Transposes square blocks of size n*n.
@@ -215,7 +192,7 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
         if (sgn(num) == 0) continue;
         mpq_class q(num, den_power);
         q.canonicalize();
-        to_lagrange_[k * n_sz + i] = nearest(q);
+        to_lagrange_[k * n_sz + i] = nearest_double(q);
       }
     }
     to_lagrange_t_ = transpose_blocks(to_lagrange_, n_sz);
@@ -298,7 +275,7 @@ void BernsteinSimplex::build_to_bezier() const {
       mpq_class row = 0;
       for (std::size_t c = 0; c < n_sz; ++c) {
         const mpq_class& q = exact_->to_bezier[r * n_sz + c];
-        to_bezier_[r * n_sz + c] = nearest(q);
+        to_bezier_[r * n_sz + c] = nearest_double(q);
         row += abs(q);
       }
       if (row > worst_row) worst_row = row;

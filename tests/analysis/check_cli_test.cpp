@@ -24,12 +24,7 @@ namespace fs = std::filesystem;
 using testing_cli::CliRun;
 using testing_cli::run_cli;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using testing_cli::slurp;
 
 class CheckCli : public testing::Test {
  protected:

@@ -21,12 +21,7 @@ namespace fs = std::filesystem;
 using testing_cli::CliRun;
 using testing_cli::run_cli;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using testing_cli::slurp;
 
 // A MSH 2.2 file of one element type (Gmsh id) from nodes and connectivity (1-based).
 void write_msh(const fs::path& path, const std::vector<std::array<double, 3>>& nodes, int type,
