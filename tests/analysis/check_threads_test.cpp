@@ -16,22 +16,9 @@ namespace {
 // `count` random curved elements of `type` (each with its own nodes) in one block.
 Mesh random_mesh(const ElementType& type, std::size_t count, unsigned seed) {
   std::mt19937 rng(seed);
-  Mesh mesh;
-  ElementBlock blk;
-  blk.type = &type;
-  blk.entity_dim = type.dim;
-  blk.entity_tag = 1;
-  for (std::size_t e = 0; e < count; ++e) {
-    const std::vector<double> x = test::random_element(type, 0.12, rng);
-    blk.tags.push_back(blk.tags.size() + 1);
-    for (std::size_t v = 0; v < x.size() / 3; ++v) {
-      blk.nodes.push_back(static_cast<NodeIndex>(mesh.node_tags.size()));
-      mesh.node_tags.push_back(mesh.node_tags.size() + 1);
-      mesh.coords.insert(mesh.coords.end(), {x[3 * v], x[3 * v + 1], x[3 * v + 2]});
-    }
-  }
-  mesh.blocks.push_back(std::move(blk));
-  return mesh;
+  std::vector<std::vector<double>> elements;
+  for (std::size_t e = 0; e < count; ++e) elements.push_back(test::random_element(type, 0.12, rng));
+  return test::mesh_of_elements(type, elements);
 }
 
 TEST(CheckThreads, SmallMeshRunsOnOneThread) {

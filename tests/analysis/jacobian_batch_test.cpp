@@ -29,24 +29,9 @@ std::vector<const ElementType*> types_up_to_3() {
 // One block of `count` random curved elements of `type`, each with its own nodes.
 Mesh random_block(const ElementType& type, std::size_t count, double amplitude, std::mt19937& rng,
                   std::vector<std::vector<double>>& elements) {
-  Mesh mesh;
-  ElementBlock blk;
-  blk.type = &type;
-  blk.entity_dim = type.dim;
-  blk.entity_tag = 1;
   elements.clear();
-  for (std::size_t e = 0; e < count; ++e) {
-    elements.push_back(test::random_element(type, amplitude, rng));
-    const auto& x = elements.back();
-    blk.tags.push_back(blk.tags.size() + 1);
-    for (std::size_t v = 0; v < x.size() / 3; ++v) {
-      blk.nodes.push_back(static_cast<NodeIndex>(mesh.node_tags.size()));
-      mesh.node_tags.push_back(mesh.node_tags.size() + 1);
-      mesh.coords.insert(mesh.coords.end(), {x[3 * v], x[3 * v + 1], x[3 * v + 2]});
-    }
-  }
-  mesh.blocks.push_back(std::move(blk));
-  return mesh;
+  for (std::size_t e = 0; e < count; ++e) elements.push_back(test::random_element(type, amplitude, rng));
+  return test::mesh_of_elements(type, elements);
 }
 
 void expect_identical(const JacobianBounds& a, const JacobianBounds& b, const std::string& what) {

@@ -153,4 +153,24 @@ inline std::map<Tag, double> read_gmsh_ratios(const std::string& path) {
   return out;
 }
 
+/// A mesh of one block holding these elements (#nodes x 3 coordinates each, Gmsh order),
+/// each with its own nodes; tags 1, 2, ... in order.
+inline Mesh mesh_of_elements(const ElementType& type, const std::vector<std::vector<double>>& elements) {
+  Mesh mesh;
+  ElementBlock blk;
+  blk.type = &type;
+  blk.entity_dim = type.dim;
+  blk.entity_tag = 1;
+  for (const std::vector<double>& x : elements) {
+    blk.tags.push_back(blk.tags.size() + 1);
+    for (std::size_t v = 0; v < x.size() / 3; ++v) {
+      blk.nodes.push_back(static_cast<NodeIndex>(mesh.node_tags.size()));
+      mesh.node_tags.push_back(mesh.node_tags.size() + 1);
+      mesh.coords.insert(mesh.coords.end(), {x[3 * v], x[3 * v + 1], x[3 * v + 2]});
+    }
+  }
+  mesh.blocks.push_back(std::move(blk));
+  return mesh;
+}
+
 }  // namespace quadval::test

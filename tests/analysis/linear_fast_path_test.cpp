@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "analysis/linear_jacobian.hpp"
+#include "jacobian_test_util.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/jacobian_bounds.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -378,20 +379,7 @@ TEST(LinearFastPath, CheckMeshAgreesWithGeneralPathPerElement) {
       for (double& c : x) c *= 1e-70;
       elements.push_back(std::move(x));
     }
-    Mesh mesh;
-    ElementBlock blk;
-    blk.type = &type;
-    blk.entity_dim = 3;
-    blk.entity_tag = 1;
-    for (const auto& x : elements) {
-      blk.tags.push_back(blk.tags.size() + 1);
-      for (std::size_t v = 0; v < x.size() / 3; ++v) {
-        blk.nodes.push_back(static_cast<NodeIndex>(mesh.node_tags.size()));
-        mesh.node_tags.push_back(mesh.node_tags.size() + 1);
-        mesh.coords.insert(mesh.coords.end(), {x[3 * v], x[3 * v + 1], x[3 * v + 2]});
-      }
-    }
-    mesh.blocks.push_back(std::move(blk));
+    const Mesh mesh = test::mesh_of_elements(type, elements);
     CheckOptions o;
     o.threads = 2;
     const CheckReport r = check_mesh(mesh, o);
