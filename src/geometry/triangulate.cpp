@@ -1,5 +1,6 @@
 // Geometry -> triangles with Gmsh's C++ API: load (file or planar domain), set the sizes and
 // the algorithm, mesh curves with odd interior node counts, then surfaces; read back.
+// Part of the Gmsh front-end module (gmsh_module.hpp).
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -14,21 +15,13 @@
 #include <fmt/core.h>
 #include <gmsh.h>
 
+#include "geometry/gmsh_module.hpp"
 #include "geometry/gmsh_session.hpp"
 #include "geometry/read_gmsh_model.hpp"
 #include "quadval/error.hpp"
 #include "quadval/geometry.hpp"
 
 namespace quadval {
-
-const char* triangle_algorithm_name(TriangleAlgorithm a) noexcept {
-  switch (a) {
-    case TriangleAlgorithm::frontal_quad: return "frontal-quad";
-    case TriangleAlgorithm::frontal: return "frontal";
-    case TriangleAlgorithm::delaunay: return "delaunay";
-  }
-  return "?";
-}
 
 namespace {
 
@@ -274,8 +267,8 @@ GeometryKind kind_of(const std::filesystem::path& path) {
 
 }  // namespace
 
-Triangulation triangulate_geometry_file(const std::filesystem::path& path,
-                                        const TriangulationOptions& options) {
+Triangulation geometry::gmsh_triangulate_file(const std::filesystem::path& path,
+                                              const TriangulationOptions& options) {
   const std::string source = path.string();
   const GeometryKind kind = kind_of(path);
   std::error_code ec;
@@ -307,8 +300,8 @@ Triangulation triangulate_geometry_file(const std::filesystem::path& path,
   return mesh_current_model(session, source, options, start);
 }
 
-Triangulation triangulate_planar_domain(const PlanarDomain& domain,
-                                        const TriangulationOptions& options) {
+Triangulation geometry::gmsh_triangulate_domain(const PlanarDomain& domain,
+                                                const TriangulationOptions& options) {
   const auto start = Clock::now();
   if (options.size) {
     // A quick look at h on a 33 x 33 grid of points inside the domain, before Gmsh starts.

@@ -9,9 +9,16 @@
 // Measured against LEMON's MaxWeightedPerfectMatching (kept as the test oracle, and for the
 // non-perfect fallback): equal optimum everywhere tested; about as fast (102k uniform
 // Frontal-Delaunay triangles: 8.8 s vs 8.1 s CPU; 35k graded: 0.17 vs 0.27 s end to end).
-// Both are slow where nearly all pair costs are equal: the alternating trees there grow over
-// most of the mesh before they meet. Blossom V's variable per-tree dual steps and per-node
-// edge lists are the known remedy and are not done here.
+// Both grow faster than linearly on large meshes (graded square with a hole: 35k triangles
+// 0.17 s, 100k 1.5 s, 300k 7 s, 1M 86 s), worst on uniform Frontal-Delaunay meshes, whose
+// triangles are nearly all equilateral (141,430 of 152,742 pairs of uniform-100k cost exactly
+// 1/3). Measured cause (event counts): the dual graph there is a honeycomb, bipartite, so the
+// free vertices a region has in excess can only pair through its defects; one tree then
+// covers whole regions of tight edges, and every augmentation dissolves it and has its
+// neighbours absorb it again (uniform-100k: 2,119 augmentations, 9.4M grow events, trees of
+// ~100k nodes). Breaking the ties by perturbing the costs does not change that (measured), nor
+// growing one tree at a time (3x slower). An algorithm that augments along many paths per
+// dual adjustment (cost scaling, or phases as in Hopcroft-Karp) would be the remedy.
 
 #include <cstdint>
 #include <span>
