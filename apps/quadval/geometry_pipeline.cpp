@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "commands.hpp"
+#include "terminal_progress.hpp"
 #include "quadval/atomic_file.hpp"
 #include "quadval/error.hpp"
 #include "quadval/io.hpp"
@@ -86,8 +87,11 @@ std::string percent_or_dash(bool has, double v) {
 
 int run_geometry_pipeline(const Triangulation& tri, const PipelineSettings& settings,
                           const PipelineOutputs& outputs, nlohmann::json report_extra) {
+  TerminalProgress progress(!settings.quiet);
   auto log = [&](const std::string& line) {
+    progress.end_line();
     if (!settings.quiet) fmt::print(stderr, "{}\n", line);
+    progress.start();  // the next stage starts
   };
   // Triangle stage.
   log(fmt::format("[triangles] {} triangles, {} nodes, {}/{} curves with an odd number of "
@@ -122,6 +126,7 @@ int run_geometry_pipeline(const Triangulation& tri, const PipelineSettings& sett
     if (settings.size)
       options.size_field = [h = *settings.size](double x, double y, double z) { return h(x, y, z); };
     options.log = log;
+    options.matching_progress = matching_progress_on(progress);
     if (!tri.all_surfaces_planar()) {
       // The smoothing and clean-up of the recombination move nodes in 3D without projecting
       // them back onto the CAD surface (measured on a cylinder of radius 0.5, h = 0.12: up to

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "terminal_progress.hpp"
 #include "quadval/atomic_file.hpp"
 #include "quadval/error.hpp"
 #include "quadval/io.hpp"
@@ -104,8 +105,11 @@ std::vector<double> element_eta(const Mesh& mesh) {
 
 int run(const RecombineCliOptions& o) {
   const auto start = std::chrono::steady_clock::now();
+  TerminalProgress progress(!o.quiet);
   auto log = [&](const std::string& line) {
+    progress.end_line();
     if (!o.quiet) fmt::print(stderr, "{}\n", line);
+    progress.start();  // the next stage starts
   };
   RecombineOptions options;
   options.source = o.input;
@@ -130,6 +134,7 @@ int run(const RecombineCliOptions& o) {
     options.size_field = [field = *size](double x, double y, double z) { return field(x, y, z); };
   }
   options.log = log;
+  options.matching_progress = matching_progress_on(progress);
 
   std::vector<std::string> read_warnings;
   const auto read_start = std::chrono::steady_clock::now();

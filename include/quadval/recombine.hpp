@@ -17,6 +17,7 @@
 ///      nodes that only accepts moves raising the worst quality there.
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
@@ -84,6 +85,10 @@ struct RecombineOptions {
   std::string source = "<mesh>";
   /// Stage log lines ("[blossom] 18342 pairs, 3.1 ms"); empty: silent.
   std::function<void(const std::string&)> log;
+  /// Blossom's progress: called after its greedy start and after each augmentation with the
+  /// triangles paired since that start and the number it left unpaired (the second is fixed).
+  /// The augmentations late in a run cost the most (their trees are the largest).
+  std::function<void(std::uint32_t paired, std::uint32_t unpaired_at_start)> matching_progress;
 };
 
 /// One timed stage of the pipeline.

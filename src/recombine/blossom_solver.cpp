@@ -87,7 +87,8 @@ enum Label : std::int8_t { kFree = 0, kPlus = 1, kMinus = 2 };
 
 class Solver {
  public:
-  Solver(std::uint32_t n, std::span<const CostEdge> edges) : n_(n), edges_(edges) {
+  Solver(std::uint32_t n, std::span<const CostEdge> edges, const MatchingProgress& progress)
+      : n_(n), edges_(edges), progress_(progress) {
     cost_.resize(edges.size());
     std::vector<std::uint32_t> degree(n + 1, 0);
     for (std::size_t e = 0; e < edges.size(); ++e) {
@@ -141,6 +142,8 @@ class Solver {
       ++alive_trees_;
       assign_plus(r, kNone, t);
     }
+    free_at_start_ = alive_trees_;
+    if (progress_) progress_(0, free_at_start_);
     return grow_trees();
   }
 
@@ -497,6 +500,7 @@ class Solver {
         } else {
           augment(static_cast<std::int32_t>(2 * e));
           dissolve(ta, tb);
+          if (progress_) progress_(free_at_start_ - alive_trees_, free_at_start_);
         }
       } else if (t == t_grow) {
         const std::uint32_t e = grow_queue_.top().id;
@@ -752,6 +756,8 @@ class Solver {
 
   std::uint32_t n_;
   std::span<const CostEdge> edges_;
+  const MatchingProgress& progress_;
+  std::uint32_t free_at_start_ = 0;
   std::vector<std::int64_t> cost_;  // doubled
   std::vector<std::uint32_t> offsets_, incident_;
   // Per vertex.
@@ -790,8 +796,8 @@ class Solver {
 }  // namespace
 
 bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
-                               std::vector<char>& matched) {
-  Solver solver(num_nodes, edges);
+                               std::vector<char>& matched, const MatchingProgress& progress) {
+  Solver solver(num_nodes, edges, progress);
   if (!solver.run()) return false;
   solver.read(matched);
   return true;

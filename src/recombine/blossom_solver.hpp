@@ -21,6 +21,7 @@
 // dual adjustment (cost scaling, or phases as in Hopcroft-Karp) would be the remedy.
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -35,11 +36,17 @@ struct CostEdge {
 /// per-tree offsets and the event keys, which are sums of a few such values.
 inline constexpr std::int64_t kMaxMatchingCost = std::int64_t{1} << 46;
 
+/// Called after the greedy start and after each augmentation with (vertices paired since the
+/// start, vertices the start left free): the second stays fixed, the first rises by 2 to it.
+using MatchingProgress = std::function<void(std::uint32_t paired, std::uint32_t free_at_start)>;
+
 /// Minimum-cost perfect matching of the graph (num_nodes, edges).
 /// @param[out] matched  #edges flags, 1 for the edges of the matching (resized here)
+/// @param progress      optional (see MatchingProgress)
 /// @return false when the graph has no perfect matching (`matched` is then unspecified)
 /// @pre every edge has u != v, u, v < num_nodes, |cost| <= kMaxMatchingCost (QV_ASSERT)
 bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
-                               std::vector<char>& matched);
+                               std::vector<char>& matched,
+                               const MatchingProgress& progress = {});
 
 }  // namespace quadval::recombine_detail

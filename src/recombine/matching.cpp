@@ -27,14 +27,14 @@ Matching read_matching(const DualGraph& g, const std::vector<char>& matched) {
 
 }  // namespace
 
-Matching blossom_matching(const DualGraph& g) {
+Matching blossom_matching(const DualGraph& g, const MatchingProgress& progress) {
   QV_ASSERT(g.num_triangles < (1u << 30), g.num_triangles << " triangles");
   std::vector<char> matched;
   if (g.num_triangles % 2 == 0) {
     std::vector<CostEdge> costs(g.pairs.size());
     for (std::uint32_t i = 0; i < g.pairs.size(); ++i)
       costs[i] = {g.pairs[i].t0, g.pairs[i].t1, -matching_weight(g.pairs[i].cost)};
-    if (min_cost_perfect_matching(g.num_triangles, costs, matched)) {
+    if (min_cost_perfect_matching(g.num_triangles, costs, matched, progress)) {
       Matching m = read_matching(g, matched);
       QV_ASSERT(m.perfect, "a perfect matching with " << m.pairs.size() << " pairs for "
                                                       << g.num_triangles);

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "blossom_solver.hpp"
 #include "dual_graph.hpp"
 
 namespace quadval::recombine_detail {
@@ -26,7 +27,8 @@ long long matching_weight(double cost) noexcept;
 /// falls back to LEMON's MaxWeightedMatching with weights 2 (1 + max cost) - cost, which
 /// leaves some triangles unmatched (perfect = false; the number left is small but not proven
 /// minimal). Costs are optimal to within 1e-9 per pair (the weight rounding).
-Matching blossom_matching(const DualGraph& g);
+/// `progress` is passed to min_cost_perfect_matching.
+Matching blossom_matching(const DualGraph& g, const MatchingProgress& progress = {});
 
 /// Greedy matching of Paper I §3: pairs by increasing cost (ties: lower pair index), taken
 /// when both triangles are still free. Extra pairs are never used.

@@ -207,7 +207,7 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   timer.stage("graph", fmt::format("{} pairs, {} extra", stats.graph_pairs, stats.extra_pairs));
 
   const Matching match = options.algorithm == RecombineAlgorithm::blossom
-                             ? blossom_matching(graph)
+                             ? blossom_matching(graph, options.matching_progress)
                              : options.algorithm == RecombineAlgorithm::lookahead
                              ? lookahead_matching(graph, s, options, stats)
                              : greedy_matching(graph);

@@ -224,6 +224,29 @@ TEST(BlossomSolver, EqualsLemonOnLargeMeshLikeGraphs) {
   }
 }
 
+// Progress: (0, F) after the greedy start, then +2 per augmentation, ending at (F, F).
+TEST(BlossomSolver, ProgressCountsThePairsUpToTheStartsFreeVertices) {
+  std::mt19937 rng(5);
+  const Graph g = mesh_like_graph(rng, 60, 1'000'000);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> calls;
+  std::vector<char> matched;
+  ASSERT_TRUE(min_cost_perfect_matching(
+      g.n, g.edges, matched,
+      [&](std::uint32_t paired, std::uint32_t free) { calls.emplace_back(paired, free); }));
+  ASSERT_GE(calls.size(), 2u);
+  const std::uint32_t free = calls.front().second;
+  EXPECT_EQ(calls.front().first, 0u);
+  EXPECT_GT(free, 0u);
+  EXPECT_LE(free, g.n);
+  EXPECT_EQ(free % 2, 0u);
+  EXPECT_EQ(calls.size(), free / 2 + 1);
+  for (std::size_t i = 1; i < calls.size(); ++i) {
+    EXPECT_EQ(calls[i].first, calls[i - 1].first + 2) << "call " << i;
+    EXPECT_EQ(calls[i].second, free);
+  }
+  EXPECT_EQ(calls.back().first, free);
+}
+
 TEST(BlossomSolver, ReportsGraphsWithoutPerfectMatching) {
   std::vector<char> matched;
   // Odd vertex count; an isolated vertex; a star K(1,3) plus an edge.
