@@ -6,6 +6,9 @@
 //
 //   build-mu/bench/quadval_bench --benchmark_filter='Mu|ScaledJacobian|Validity' --benchmark_repetitions=3
 // Counters: elements/s; "subdiv" is the mean number of subdomains split per element for mu.
+// BM_MuMode/<type>/<mode> compares mu's subdomain bounds (mu_control_bound.hpp): 0 the
+// degree-12n certificate alone (the method before the control-matrix bound), 1 the
+// control-matrix bound alone, 2 the default.
 #include <benchmark/benchmark.h>
 
 #include <random>
@@ -15,6 +18,7 @@
 #include "quadval/lagrange_basis.hpp"
 #include "quadval/mu_bounds.hpp"
 #include "quadval/scaled_jacobian.hpp"
+#include "analysis/mu_control_bound.hpp"
 
 namespace quadval {
 namespace {
@@ -48,6 +52,10 @@ std::vector<double> random_elements(const ElementType& type, int count) {
 
 void BM_Mu(benchmark::State& state) {
   const ElementType& type = *find_element_type(static_cast<int>(state.range(0)));
+  // Second argument (BM_MuMode): the subdomain bound of mu_control_bound.hpp's
+  // mu_use_control_bound (0 certificate alone, 1 control matrices alone, 2 both).
+  const int mode = state.range(1) >= 0 ? static_cast<int>(state.range(1)) : 2;
+  mu_use_control_bound(mode);
   const int kBatch = batch(type);
   const auto x = random_elements(type, kBatch);
   const std::size_t stride = 3 * static_cast<std::size_t>(type.num_nodes);
@@ -65,6 +73,7 @@ void BM_Mu(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kBatch);
   state.counters["subdiv"] = double(subdivisions) / double(state.iterations() * kBatch);
   state.SetLabel(std::string(type.name));
+  mu_use_control_bound(2);
 }
 
 // The certified minimum of the scaled Jacobian (scaled_jacobian_bounds, default tolerance).
@@ -112,7 +121,9 @@ void BM_Validity(benchmark::State& state) {
 // Triangles 3, 6, 10; quadrangles 4, 9, 16; tetrahedra 4, 10, 20; prisms 6, 18;
 // hexahedra 8, 27 (orders 1-3 where mu_supported).
 #define QV_MU_TYPES ->Arg(2)->Arg(9)->Arg(21)->Arg(3)->Arg(10)->Arg(36)->Arg(4)->Arg(11)->Arg(29)->Arg(6)->Arg(13)->Arg(5)->Arg(12)
-BENCHMARK(BM_Mu) QV_MU_TYPES->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Mu)->ArgsProduct({{2, 9, 21, 3, 10, 36, 4, 11, 29, 6, 13, 5, 12}, {-1}})->Unit(benchmark::kMicrosecond);
+// The three subdomain bounds side by side.
+BENCHMARK(BM_Mu)->Name("BM_MuMode")->ArgsProduct({{2, 9, 21, 3, 10, 36, 4, 11, 29, 6, 13, 5, 12}, {0, 1, 2}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ScaledJacobian) QV_MU_TYPES->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Validity) QV_MU_TYPES->Unit(benchmark::kMicrosecond);
 

@@ -2,15 +2,23 @@
 // Jacobian range, distortion), Thesis Paper III, and the certified quality measures mu
 // (Paper V) and scaled Jacobian; a terminal summary and per-element files.
 //
+//
 //   quadval check mesh.msh
 //   quadval check mesh.msh --measure distortion --threads 2 -o report.csv -o coloured.vtu
 //   quadval check mesh.msh --measure all --tol 1e-3 -o report.csv
+//
+// Results stream: elements are analysed in batches, CSV/JSON rows are written as each batch
+// finishes and VTU/MSH keep one double per element and field, so memory stays near the
+// mesh's own whatever its size (-v prints both).
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -36,8 +44,25 @@ struct CheckCliOptions {
   int threads = 0;
   int worst = 10;
   bool quiet = false;
+  bool verbose = false;
   std::vector<std::string> outputs;
 };
+
+// The mesh's own memory: the bytes of its per-node and per-element arrays (node tags,
+// coordinates, and per block the element tags and connectivity), by size, not capacity;
+// entities and physical names (a few bytes per model entity) are left out.
+std::size_t mesh_bytes(const Mesh& mesh) {
+  std::size_t n = mesh.node_tags.size() * sizeof(Tag) + mesh.coords.size() * sizeof(double);
+  for (const ElementBlock& b : mesh.blocks) n += b.tags.size() * sizeof(Tag) + b.nodes.size() * sizeof(NodeIndex);
+  return n;
+}
+
+// Peak resident memory of this process so far (Linux: ru_maxrss in KiB).
+std::size_t peak_resident_bytes() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return static_cast<std::size_t>(u.ru_maxrss) * 1024;
+}
 
 std::string lower_extension(const std::string& path) {
   std::string e = std::filesystem::path(path).extension().string();
@@ -78,29 +103,70 @@ int run_check(const CheckCliOptions& o) {
       shown = true;
     };
   }
-  const CheckReport report = check_mesh(mesh, opts, o.input);
-  if (shown) fmt::print(stderr, "\r{}\r", std::string(60, ' '));
+  const std::size_t worst = static_cast<std::size_t>(std::max(0, o.worst));
+  opts.worst = worst;
 
-  if (!o.quiet) fmt::print("{}", format_check_summary(report, static_cast<std::size_t>(std::max(0, o.worst))));
+  // CSV and JSON files are open (as temporaries, renamed once complete) during the
+  // analysis and get their rows batch by batch; VTU/MSH get the collected fields after it.
+  std::vector<std::string> text_outputs, mesh_outputs;
   for (const std::string& out : o.outputs) {
     const std::string e = lower_extension(out);
-    if (e == ".csv") {
-      const std::string text = check_csv(report);
-      write_file_atomically(out, [&text](std::ostream& os) { os << text; });
-    } else if (e == ".json") {
-      const std::string text = check_json(report);
-      write_file_atomically(out, [&text](std::ostream& os) { os << text; });
-    } else {
-      std::vector<ElementField> fields;
-      for (auto& [name, values] : check_fields(mesh, report)) fields.push_back({name, std::move(values)});
-      WriteOptions w;
-      w.format = e == ".vtu" ? MeshFormat::vtu : MeshFormat::msh41;
-      write_mesh(mesh, out, w, fields);
-    }
-    if (!o.quiet) fmt::print("[check] wrote {}\n", out);
+    (e == ".csv" || e == ".json" ? text_outputs : mesh_outputs).push_back(out);
   }
-  const bool all_valid = report.count(Validity::invalid) == 0 && report.count(Validity::undetermined) == 0 &&
-                         report.skipped() == 0;
+  std::optional<CheckFieldCollector> fields;
+  if (!mesh_outputs.empty()) fields.emplace(mesh, opts.measure);
+  std::vector<std::ostream*> csv_streams;
+  std::vector<CheckJsonWriter> json_writers;
+  CheckSummary summary;
+  const std::function<void(std::size_t)> open_then_check = [&](std::size_t k) {
+    if (k == text_outputs.size()) {
+      summary = check_mesh_streamed(mesh, opts, o.input, [&](const CheckBatch& batch) {
+        if (!csv_streams.empty()) {
+          std::string rows;
+          append_check_csv_rows(rows, batch);
+          for (std::ostream* os : csv_streams) *os << rows;
+        }
+        for (CheckJsonWriter& w : json_writers) w.add(batch);
+        if (fields) fields->add(batch);
+      });
+      for (CheckJsonWriter& w : json_writers) w.finish(summary);
+      return;
+    }
+    write_file_atomically(text_outputs[k], [&](std::ostream& os) {
+      if (lower_extension(text_outputs[k]) == ".csv") {
+        os << check_csv_header();
+        csv_streams.push_back(&os);
+      } else {
+        json_writers.emplace_back(os);
+      }
+      open_then_check(k + 1);
+    });
+  };
+  open_then_check(0);
+  if (shown) fmt::print(stderr, "\r{}\r", std::string(60, ' '));
+
+  if (!o.quiet) fmt::print("{}", format_check_summary(summary, worst));
+  if (fields) {
+    std::vector<ElementField> mesh_fields;
+    for (auto& [name, values] : fields->take()) mesh_fields.push_back({name, std::move(values)});
+    for (const std::string& out : mesh_outputs) {
+      WriteOptions w;
+      w.format = lower_extension(out) == ".vtu" ? MeshFormat::vtu : MeshFormat::msh41;
+      write_mesh(mesh, out, w, mesh_fields);
+    }
+  }
+  if (!o.quiet)
+    for (const std::string& out : o.outputs) fmt::print("[check] wrote {}\n", out);
+  if (o.verbose) {
+    const double mib = 1024.0 * 1024.0;
+    const std::size_t own = mesh_bytes(mesh), peak = peak_resident_bytes();
+    fmt::print("[check] memory: mesh {:.1f} MiB (node tags, coordinates, element tags, connectivity), "
+               "peak resident {:.1f} MiB, {:.2f} x the mesh\n",
+               static_cast<double>(own) / mib, static_cast<double>(peak) / mib,
+               own ? static_cast<double>(peak) / static_cast<double>(own) : 0.0);
+  }
+  const bool all_valid = summary.count(Validity::invalid) == 0 && summary.count(Validity::undetermined) == 0 &&
+                         summary.skipped() == 0;
   return all_valid ? kExitOk : kExitFindings;
 }
 
@@ -149,6 +215,9 @@ void add_check_command(CLI::App& app, int& exit_code) {
                   "Write per-element results: .csv, .json, or the mesh with per-element fields\n"
                   "(.vtu for ParaView, .msh for Gmsh); may be given several times");
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing (the exit status tells)");
+  cmd->add_flag("-v,--verbose", o->verbose,
+                "Also print the mesh's own memory (its node and element arrays) and the peak\n"
+                "resident memory of the run (even with --quiet)");
   cmd->callback([o, &exit_code] { exit_code = run_check(*o); });
 }
 

@@ -76,9 +76,10 @@ class BernsteinSimplex {
   double lagrange_to_bezier_norm() const;
   /// V = T^-1 (size x size, row-major): values at the points = V * Bézier coefficients,
   /// V_ki = B_i(point k), each entry the double nearest to the exact rational. Entries are
-  /// nonnegative and each exact row sums to 1 (partition of unity, eq. 14).
-  std::span<const double> bezier_to_lagrange() const noexcept { return to_lagrange_; }
-  std::span<const double> bezier_to_lagrange_transposed() const noexcept { return to_lagrange_t_; }
+  /// nonnegative and each exact row sums to 1 (partition of unity, eq. 14). Built on first
+  /// use (thread-safe): only sampling beyond the sampled orders needs it.
+  std::span<const double> bezier_to_lagrange() const;
+  std::span<const double> bezier_to_lagrange_transposed() const;
   /// The exact T and other rational data (src/bezier/bezier_exact.hpp; GMP stays out
   /// of the public headers). Building it inverts the collocation matrix on first use.
   struct Exact;
@@ -106,7 +107,9 @@ class BernsteinSimplex {
   mutable std::once_flag to_bezier_once_;
   mutable std::vector<double> to_bezier_, to_bezier_t_;
   mutable double to_bezier_norm_ = 0;
-  std::vector<double> to_lagrange_, to_lagrange_t_;
+  void build_to_lagrange() const;
+  mutable std::once_flag to_lagrange_once_;
+  mutable std::vector<double> to_lagrange_, to_lagrange_t_;
   std::unique_ptr<Exact> exact_;
   std::vector<std::array<std::array<int, 4>, 4>> children_;
   std::vector<double> subdivision_, subdivision_t_;  // num_children blocks of size*size

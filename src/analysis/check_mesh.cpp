@@ -1,6 +1,9 @@
 // check_mesh: the batched, threaded analysis of a whole mesh (Paper III §4.4: samples and
 // first Bézier coefficients for many elements at once; only the undecided few are
 // subdivided). Fixed chunks of one block make the results independent of the threads.
+// Chunks are grouped in batches of kCheckBatch elements: one batch of results exists at a
+// time, handed to the sink and folded into the summary before the next one starts, so the
+// memory beyond the mesh does not grow with it.
 #include <omp.h>
 
 #include <algorithm>
@@ -9,13 +12,17 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <span>
+#include <thread>
 #include <utility>
 
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/check_summary.hpp"
 #include "analysis/linear_jacobian.hpp"
+#include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "quadval/check_report.hpp"
@@ -28,6 +35,7 @@ namespace {
 
 constexpr std::size_t kChunk = 256;
 static_assert(kChunk <= kLinearChunk);
+static_assert(kCheckBatch % kChunk == 0);
 
 double now_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
@@ -36,6 +44,7 @@ double now_seconds() {
 // Per-thread accumulators, merged at the end (sums are order-independent integers; the
 // times are only reported).
 struct ThreadStats {
+  CheckSummary summary;  // histograms and worst lists of this thread's elements
   std::vector<StageRow> stages;
   std::size_t exact = 0;
   std::map<int, std::array<std::size_t, 4>> counts;  // as CheckReport::counts
@@ -57,11 +66,11 @@ std::string stage_name(std::size_t i) {
 
 }  // namespace
 
-CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std::string& file) {
+CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, const std::string& file,
+                                 const CheckSink& sink) {
   const double t0 = now_seconds();
-  CheckReport report;
-  report.file = file;
-  report.measure = options.measure;
+  double sink_seconds = 0;
+  CheckSummary report = empty_summary(file, options.measure, options.worst);
   report.dimension = mesh.dimension();
   for (double c : mesh.coords)
     if (!std::isfinite(c)) throw InputError::in_file(file, "a node coordinate is not finite");
@@ -108,10 +117,37 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
       chunks.push_back({b, e, std::min(kChunk, blk.size() - e), total + e});
     total += blk.size();
   }
-  report.elements.resize(total);
-  if (measures_distortion(options.measure)) report.distortion.assign(total, DistortionBounds{NAN, NAN});
-  if (want_mu) report.mu.assign(total, kNotComputed);
-  if (want_sj) report.sj.assign(total, kNotComputed);
+  report.elements = total;
+  // Batches: runs of whole chunks, at most kCheckBatch elements each (chunks never span
+  // blocks, so a batch may hold fewer). Batch b holds chunks [batches[b], batches[b + 1]).
+  std::vector<std::size_t> batches;
+  for (std::size_t c = 0; c < chunks.size(); ++c)
+    if (batches.empty() || chunks[c].out + chunks[c].count - chunks[batches.back()].out > kCheckBatch)
+      batches.push_back(c);
+  const std::size_t num_batches = batches.size();
+  batches.push_back(chunks.size());
+  std::vector<std::size_t> batch_of(chunks.size()), batch_first(num_batches), batch_size(num_batches);
+  for (std::size_t b = 0; b < num_batches; ++b) {
+    for (std::size_t c = batches[b]; c < batches[b + 1]; ++c) batch_of[c] = b;
+    batch_first[b] = chunks[batches[b]].out;
+    batch_size[b] = chunks[batches[b + 1] - 1].out + chunks[batches[b + 1] - 1].count - batch_first[b];
+  }
+  // Results of batch b live in buffer b % kInFlight until the calling thread has handed
+  // them out (flushed): threads go on with later batches meanwhile, with no barrier.
+  constexpr std::size_t kInFlight = 4;
+  struct Buffer {
+    std::vector<ElementCheck> elements;
+    std::vector<DistortionBounds> distortion;  // per-element measures only when measured
+    std::vector<QualityBounds> mu, sj;
+  };
+  std::vector<Buffer> buffers(std::min(kInFlight, num_batches));
+  for (Buffer& buf : buffers) {
+    const std::size_t capacity = std::min(total, kCheckBatch);
+    buf.elements.resize(capacity);
+    buf.distortion.resize(measures_distortion(options.measure) ? capacity : 0);
+    buf.mu.resize(want_mu ? capacity : 0);
+    buf.sj.resize(want_sj ? capacity : 0);
+  }
 
   // Build the shared spaces up front (once per type, outside the parallel region), except
   // for fast-path types: their space is built (thread-safely) only if an element needs it.
@@ -141,151 +177,227 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
       std::max<std::size_t>(1, std::min({static_cast<std::size_t>(requested), chunks.size(), useful})));
   report.threads = threads;
   std::vector<ThreadStats> stats(static_cast<std::size_t>(threads));
+  for (ThreadStats& st : stats) st.summary = empty_summary(file, options.measure, options.worst);
   std::atomic<std::size_t> done{0};
   std::exception_ptr failure;
+  std::atomic<bool> failed{false};
+  std::atomic<std::size_t> next_chunk{0};  // chunks are claimed in order
+  std::atomic<std::size_t> flushed{0};     // batches handed out so far
+  const auto remaining = std::make_unique<std::atomic<std::size_t>[]>(num_batches);  // chunks left
+  for (std::size_t b = 0; b < num_batches; ++b) remaining[b] = batches[b + 1] - batches[b];
+  const auto fail = [&](std::exception_ptr e) {
+#pragma omp critical(check_failure)
+    if (!failure) failure = e;
+    failed = true;
+  };
+  // On the calling thread (OpenMP's master): hands out every finished batch, in order.
+  const auto flush_ready = [&] {
+    for (std::size_t b = flushed.load(std::memory_order_relaxed);
+         b < num_batches && !failed && remaining[b].load(std::memory_order_acquire) == 0; ++b) {
+      const Buffer& buf = buffers[b % buffers.size()];
+      CheckBatch out;
+      out.first = batch_first[b];
+      out.elements = std::span<const ElementCheck>(buf.elements.data(), batch_size[b]);
+      if (!buf.distortion.empty()) out.distortion = std::span<const DistortionBounds>(buf.distortion.data(), batch_size[b]);
+      if (!buf.mu.empty()) out.mu = std::span<const QualityBounds>(buf.mu.data(), batch_size[b]);
+      if (!buf.sj.empty()) out.sj = std::span<const QualityBounds>(buf.sj.data(), batch_size[b]);
+      add_sums(report, out);  // in element order
+      if (sink) {
+        const double ts = now_seconds();
+        try {
+          sink(out);
+        } catch (...) {
+          fail(std::current_exception());
+        }
+        sink_seconds += now_seconds() - ts;
+      }
+      flushed.store(b + 1, std::memory_order_release);  // its buffer may now be reused
+    }
+  };
 
 #pragma omp parallel num_threads(threads)
   {
+    const bool master = omp_get_thread_num() == 0;
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(omp_get_thread_num())];
     std::vector<double> nodes, errors, coeffs, soa;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
-#pragma omp for schedule(dynamic, 1)
-    for (std::size_t c = 0; c < chunks.size(); ++c) {
-      try {
-        const Chunk& ch = chunks[c];
-        const ElementBlock& blk = mesh.blocks[ch.block];
-        const ElementType& type = *blk.type;
-        for (std::size_t i = 0; i < ch.count; ++i) {
-          ElementCheck& ec = report.elements[ch.out + i];
-          ec.tag = blk.tags[ch.first + i];
-          ec.type = &type;
-        }
-        const LinearKind fast = fast_path ? linear_kind(type, report.planar) : LinearKind::none;
-        if (!jacobian_supported(type))  // skipped elements are skipped for mu and sj too
-          for (QualityCounts* qc : {want_mu ? &st.mu : nullptr, want_sj ? &st.sj : nullptr})
-            if (qc) {
-              qc->skipped += ch.count;
-              qc->skipped_types[type.gmsh_id] += ch.count;
-            }
-        if (jacobian_supported(type)) {
-          const auto nn = static_cast<std::size_t>(type.num_nodes);
-          // mu or the scaled Jacobian of one element, or a skip said so.
-          const auto quality = [&](bool supported, QualityBounds& out, QualityCounts& qc, const double* xe,
-                                   auto bounds_of) {
-            if (!supported) {
-              ++qc.skipped;
-              ++qc.skipped_types[type.gmsh_id];
-              return;
-            }
-            out = bounds_of(type, std::span<const double>(xe, nn * 3), qo, report.planar);
-            ++qc.computed;
-            if (!out.tolerance_met) ++qc.tolerance_not_met;
-          };
-          // What every analysed element gets once its bounds are known.
-          const auto finish = [&](std::size_t index, const double* xe, double seconds) {
-            ElementCheck& ec = report.elements[index];
-            ec.analysed = true;
-            const JacobianBounds& b = ec.bounds;
-            if (measures_distortion(options.measure))
-              report.distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
-            if (want_mu) quality(mu_supported(type), report.mu[index], st.mu, xe, mu_bounds);
-            if (want_sj)
-              quality(scaled_jacobian_supported(type), report.sj[index], st.sj, xe,
-                      [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
-                                       bool planar) { return scaled_jacobian_bounds_given(t, x, q, planar, v); });
-            if (b.exact) ++st.exact;
-            st.add(b.stage, b.validity, seconds);
-          };
-          if (fast != LinearKind::none) {
-            // First-order fast path (linear_jacobian.hpp): the coefficients straight from
-            // the vertices; the few it leaves open go one by one to the general path.
-            const double ts = now_seconds();
-            const auto nv = static_cast<std::size_t>(linear_num_vertices(fast));
-            soa.resize(nv * 3 * kLinearChunk);
-            for (std::size_t i = 0; i < ch.count; ++i) {
-              const auto conn = blk.element(ch.first + i);
-              for (std::size_t k = 0; k < nv; ++k)
-                for (std::size_t j = 0; j < 3; ++j)
-                  soa[(k * 3 + j) * kLinearChunk + i] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
-            }
-            fast_bounds.resize(ch.count);
-            linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
-            const double share = (now_seconds() - ts) / static_cast<double>(ch.count);
-            nodes.resize(nn * 3);
-            errors.resize(1);
-            for (std::size_t i = 0; i < ch.count; ++i) {
-              ElementCheck& ec = report.elements[ch.out + i];
-              const auto conn = blk.element(ch.first + i);
-              if (decided[i]) {
-                ec.bounds = fast_bounds[i];
-                finish(ch.out + i, nullptr, share);  // no distortion: fast_path is validity only
-                continue;
+    for (;;) {
+      const std::size_t c = next_chunk.fetch_add(1, std::memory_order_relaxed);
+      if (c >= chunks.size() || failed) break;
+      const std::size_t batch = batch_of[c];
+      // Wait for this batch's buffer: the batch kInFlight before it must be handed out.
+      // Its chunks were all claimed before this one, so this always ends.
+      while (batch >= flushed.load(std::memory_order_acquire) + buffers.size() && !failed) {
+        if (master) flush_ready();
+        else std::this_thread::yield();
+      }
+      if (failed) break;
+      Buffer& buf = buffers[batch % buffers.size()];
+      std::vector<ElementCheck>& elements = buf.elements;
+      std::vector<DistortionBounds>& distortion = buf.distortion;
+      std::vector<QualityBounds>& mu = buf.mu;
+      std::vector<QualityBounds>& sj = buf.sj;
+      {
+        try {
+          Chunk ch = chunks[c];
+          ch.out -= batch_first[batch];  // index into this batch's results
+          const ElementBlock& blk = mesh.blocks[ch.block];
+          const ElementType& type = *blk.type;
+          // Fresh records (the results' slots are reused from batch to batch).
+          for (std::size_t i = 0; i < ch.count; ++i) {
+            ElementCheck& ec = elements[ch.out + i];
+            ec = ElementCheck{};
+            ec.tag = blk.tags[ch.first + i];
+            ec.type = &type;
+            if (!distortion.empty()) distortion[ch.out + i] = DistortionBounds{NAN, NAN};
+            if (!mu.empty()) mu[ch.out + i] = kNotComputed;
+            if (!sj.empty()) sj[ch.out + i] = kNotComputed;
+          }
+          const LinearKind fast = fast_path ? linear_kind(type, report.planar) : LinearKind::none;
+          if (!jacobian_supported(type))  // skipped elements are skipped for mu and sj too
+            for (QualityCounts* qc : {want_mu ? &st.mu : nullptr, want_sj ? &st.sj : nullptr})
+              if (qc) {
+                qc->skipped += ch.count;
+                qc->skipped_types[type.gmsh_id] += ch.count;
               }
-              const double te = now_seconds();
+          if (jacobian_supported(type)) {
+            const auto nn = static_cast<std::size_t>(type.num_nodes);
+            // mu or the scaled Jacobian of one element, or a skip said so.
+            const auto quality = [&](bool supported, QualityBounds& out, QualityCounts& qc, const double* xe,
+                                     auto bounds_of) {
+              if (!supported) {
+                ++qc.skipped;
+                ++qc.skipped_types[type.gmsh_id];
+                return;
+              }
+              out = bounds_of(type, std::span<const double>(xe, nn * 3), qo, report.planar);
+              ++qc.computed;
+              if (!out.tolerance_met) ++qc.tolerance_not_met;
+            };
+            // What every analysed element gets once its bounds are known.
+            const auto finish = [&](std::size_t index, const double* xe, double seconds) {
+              ElementCheck& ec = elements[index];
+              ec.analysed = true;
+              const JacobianBounds& b = ec.bounds;
+              if (measures_distortion(options.measure))
+                distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
+              if (want_mu)
+                quality(mu_supported(type), mu[index], st.mu, xe,
+                        [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
+                                         bool planar) { return mu_bounds_given(t, x, q, planar, v); });
+              if (want_sj)
+                quality(scaled_jacobian_supported(type), sj[index], st.sj, xe,
+                        [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
+                                         bool planar) { return scaled_jacobian_bounds_given(t, x, q, planar, v); });
+              if (b.exact) ++st.exact;
+              st.add(b.stage, b.validity, seconds);
+            };
+            if (fast != LinearKind::none) {
+              // First-order fast path (linear_jacobian.hpp): the coefficients straight from
+              // the vertices; the few it leaves open go one by one to the general path.
+              const double ts = now_seconds();
+              const auto nv = static_cast<std::size_t>(linear_num_vertices(fast));
+              soa.resize(nv * 3 * kLinearChunk);
+              for (std::size_t i = 0; i < ch.count; ++i) {
+                const auto conn = blk.element(ch.first + i);
+                for (std::size_t k = 0; k < nv; ++k)
+                  for (std::size_t j = 0; j < 3; ++j)
+                    soa[(k * 3 + j) * kLinearChunk + i] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+              }
+              fast_bounds.resize(ch.count);
+              linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
+              const double share = (now_seconds() - ts) / static_cast<double>(ch.count);
+              nodes.resize(nn * 3);
+              errors.resize(1);
+              for (std::size_t i = 0; i < ch.count; ++i) {
+                ElementCheck& ec = elements[ch.out + i];
+                const auto conn = blk.element(ch.first + i);
+                if (decided[i]) {
+                  ec.bounds = fast_bounds[i];
+                  finish(ch.out + i, nullptr, share);  // no distortion: fast_path is validity only
+                  continue;
+                }
+                const double te = now_seconds();
+                const JacobianSpace& space = jacobian_space(type);
+                coeffs.resize(static_cast<std::size_t>(space.basis().size()));
+                for (std::size_t k = 0; k < nn; ++k)
+                  for (std::size_t j = 0; j < 3; ++j)
+                    nodes[k * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+                jacobian_coefficients(space, nodes.data(), 1, report.planar, coeffs.data(),
+                                      errors.data(), ws.sample_scratch.product);
+                ec.bounds = bounds_from_coefficients(space, coeffs.data(), errors[0], nodes.data(),
+                                                     report.planar, bo, ws);
+                finish(ch.out + i, nodes.data(), share + (now_seconds() - te));
+              }
+            } else {
+              // The product path (jacobian_product.hpp): the chunk's Bézier coefficients of J
+              // straight from its nodes, then each element's bounds exactly as jacobian_bounds
+              // computes them (bit-identical; tests/analysis/jacobian_batch_test.cpp).
               const JacobianSpace& space = jacobian_space(type);
-              coeffs.resize(static_cast<std::size_t>(space.basis().size()));
-              for (std::size_t k = 0; k < nn; ++k)
-                for (std::size_t j = 0; j < 3; ++j)
-                  nodes[k * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
-              jacobian_coefficients(space, nodes.data(), 1, report.planar, coeffs.data(),
+              const auto s = static_cast<std::size_t>(space.basis().size());
+              nodes.resize(ch.count * nn * 3);
+              for (std::size_t i = 0; i < ch.count; ++i) {
+                const auto conn = blk.element(ch.first + i);
+                for (std::size_t k = 0; k < nn; ++k)
+                  for (std::size_t j = 0; j < 3; ++j)
+                    nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+              }
+              coeffs.resize(ch.count * s);
+              errors.resize(ch.count);
+              const double ts = now_seconds();
+              jacobian_coefficients(space, nodes.data(), ch.count, report.planar, coeffs.data(),
                                     errors.data(), ws.sample_scratch.product);
-              ec.bounds = bounds_from_coefficients(space, coeffs.data(), errors[0], nodes.data(),
-                                                   report.planar, bo, ws);
-              finish(ch.out + i, nodes.data(), share + (now_seconds() - te));
-            }
-          } else {
-            // The product path (jacobian_product.hpp): the chunk's Bézier coefficients of J
-            // straight from its nodes, then each element's bounds exactly as jacobian_bounds
-            // computes them (bit-identical; tests/analysis/jacobian_batch_test.cpp).
-            const JacobianSpace& space = jacobian_space(type);
-            const auto s = static_cast<std::size_t>(space.basis().size());
-            nodes.resize(ch.count * nn * 3);
-            for (std::size_t i = 0; i < ch.count; ++i) {
-              const auto conn = blk.element(ch.first + i);
-              for (std::size_t k = 0; k < nn; ++k)
-                for (std::size_t j = 0; j < 3; ++j)
-                  nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
-            }
-            coeffs.resize(ch.count * s);
-            errors.resize(ch.count);
-            const double ts = now_seconds();
-            jacobian_coefficients(space, nodes.data(), ch.count, report.planar, coeffs.data(),
-                                  errors.data(), ws.sample_scratch.product);
-            const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
-            for (std::size_t i = 0; i < ch.count; ++i) {
-              const double te = now_seconds();
-              ElementCheck& ec = report.elements[ch.out + i];
-              const double* xe = nodes.data() + i * nn * 3;
-              ec.bounds = bounds_from_coefficients(space, coeffs.data() + i * s, errors[i], xe,
-                                                   report.planar, bo, ws);
-              finish(ch.out + i, xe, batch_share + (now_seconds() - te));
+              const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
+              for (std::size_t i = 0; i < ch.count; ++i) {
+                const double te = now_seconds();
+                ElementCheck& ec = elements[ch.out + i];
+                const double* xe = nodes.data() + i * nn * 3;
+                ec.bounds = bounds_from_coefficients(space, coeffs.data() + i * s, errors[i], xe,
+                                                     report.planar, bo, ws);
+                finish(ch.out + i, xe, batch_share + (now_seconds() - te));
+              }
             }
           }
+          // Counts per type, here rather than in a serial pass over all elements.
+          std::array<std::size_t, 4> chunk_counts{};
+          for (std::size_t i = 0; i < ch.count; ++i) {
+            const ElementCheck& ec = elements[ch.out + i];
+            chunk_counts[ec.analysed ? static_cast<std::size_t>(ec.bounds.validity) : 3] += 1;
+          }
+          auto& type_counts = st.counts[type.gmsh_id];
+          for (std::size_t k = 0; k < 4; ++k) type_counts[k] += chunk_counts[k];
+          // Histograms and worst lists too (order-independent; merged after the loop).
+          CheckBatch mine;
+          mine.first = batch_first[batch];
+          mine.elements = elements;
+          if (!distortion.empty()) mine.distortion = distortion;
+          if (!mu.empty()) mine.mu = mu;
+          if (!sj.empty()) mine.sj = sj;
+          add_elements(st.summary, mine, ch.out, ch.out + ch.count);
+          const std::size_t d = done.fetch_add(ch.count) + ch.count;
+          if (options.progress && omp_get_thread_num() == 0) options.progress(d, total);
+        } catch (...) {
+          fail(std::current_exception());
         }
-        // Counts per type, here rather than in a serial pass over all elements.
-        std::array<std::size_t, 4> chunk_counts{};
-        for (std::size_t i = 0; i < ch.count; ++i) {
-          const ElementCheck& ec = report.elements[ch.out + i];
-          chunk_counts[ec.analysed ? static_cast<std::size_t>(ec.bounds.validity) : 3] += 1;
-        }
-        auto& type_counts = st.counts[type.gmsh_id];
-        for (std::size_t k = 0; k < 4; ++k) type_counts[k] += chunk_counts[k];
-        const std::size_t d = done.fetch_add(ch.count) + ch.count;
-        if (options.progress && omp_get_thread_num() == 0) options.progress(d, total);
-      } catch (...) {
-#pragma omp critical
-        if (!failure) failure = std::current_exception();
       }
+      remaining[batch].fetch_sub(1, std::memory_order_acq_rel);  // publishes the results
+      if (master) flush_ready();
     }
+    if (master)
+      while (!failed && flushed.load(std::memory_order_relaxed) < num_batches) {
+        flush_ready();
+        if (flushed.load(std::memory_order_relaxed) < num_batches) std::this_thread::yield();
+      }
   }
   if (failure) std::rethrow_exception(failure);
 
   for (const ThreadStats& st : stats) {
+    merge_summary(report, st.summary);
     report.exact_fallbacks += st.exact;
-    for (auto [from, to] : {std::pair{&st.mu, &report.mu_counts}, std::pair{&st.sj, &report.sj_counts}}) {
+    for (auto [from, to] : {std::pair{&st.mu, &report.mu.counts}, std::pair{&st.sj, &report.sj.counts}}) {
       to->computed += from->computed;
       to->skipped += from->skipped;
       to->tolerance_not_met += from->tolerance_not_met;
@@ -302,7 +414,35 @@ CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std:
   }
   if (report.stages.size() < 2) report.stages.resize(2);
   for (std::size_t i = 0; i < report.stages.size(); ++i) report.stages[i].name = stage_name(i);
-  report.seconds = now_seconds() - t0;
+  report.seconds = now_seconds() - t0 - sink_seconds;
+  return report;
+}
+
+CheckReport check_mesh(const Mesh& mesh, const CheckOptions& options, const std::string& file) {
+  CheckReport report;
+  std::size_t total = 0;
+  for (const ElementBlock& b : mesh.blocks)
+    if (b.type->dim == mesh.dimension()) total += b.size();
+  report.elements.reserve(total);
+  const bool want_distortion = measures_distortion(options.measure);
+  const bool want_mu = measures_mu(options.measure), want_sj = measures_scaled_jacobian(options.measure);
+  const CheckSummary summary = check_mesh_streamed(mesh, options, file, [&](const CheckBatch& b) {
+    report.elements.insert(report.elements.end(), b.elements.begin(), b.elements.end());
+    if (want_distortion) report.distortion.insert(report.distortion.end(), b.distortion.begin(), b.distortion.end());
+    if (want_mu) report.mu.insert(report.mu.end(), b.mu.begin(), b.mu.end());
+    if (want_sj) report.sj.insert(report.sj.end(), b.sj.begin(), b.sj.end());
+  });
+  report.file = summary.file;
+  report.measure = summary.measure;
+  report.dimension = summary.dimension;
+  report.planar = summary.planar;
+  report.counts = summary.counts;
+  report.stages = summary.stages;
+  report.exact_fallbacks = summary.exact_fallbacks;
+  report.mu_counts = summary.mu.counts;
+  report.sj_counts = summary.sj.counts;
+  report.seconds = summary.seconds;
+  report.threads = summary.threads;
   return report;
 }
 
@@ -349,7 +489,8 @@ std::vector<std::size_t> CheckReport::worst_quality(std::size_t n, bool sj) cons
   std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m), idx.end(),
                     [&](std::size_t a, std::size_t b) {
                       const double ka = key(a), kb = key(b);
-                      return ka != kb ? ka < kb : elements[a].tag < elements[b].tag;
+                      if (ka != kb) return ka < kb;
+                      return elements[a].tag != elements[b].tag ? elements[a].tag < elements[b].tag : a < b;
                     });
   idx.resize(m);
   return idx;
@@ -369,7 +510,8 @@ std::vector<std::size_t> CheckReport::worst(std::size_t n) const {
   std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m), idx.end(),
                     [&](std::size_t a, std::size_t b) {
                       const double ka = key(a), kb = key(b);
-                      return ka != kb ? ka < kb : elements[a].tag < elements[b].tag;
+                      if (ka != kb) return ka < kb;
+                      return elements[a].tag != elements[b].tag ? elements[a].tag < elements[b].tag : a < b;
                     });
   idx.resize(m);
   return idx;

@@ -3,8 +3,11 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <iterator>
+#include <ostream>
 #include <tuple>
 #include <vector>
 #include <nlohmann/json.hpp>
@@ -22,37 +25,19 @@ const char* answer(const ElementCheck& e) {
   return e.analysed ? validity_name(e.bounds.validity) : "skipped";
 }
 
-// The scale-free quality the histogram and the worst list use.
-double quality(const CheckReport& r, std::size_t i) {
-  return measures_distortion(r.measure) ? r.distortion_of(i).lower : r.elements[i].ratio_lower();
-}
-
-// Histogram lines of values in [-1, 1] (bins of 0.1 from 0, one bin below 0).
-void histogram(std::string& out, const std::vector<double>& values) {
-  static constexpr double kEdges[] = {-INFINITY, 0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, INFINITY};
-  std::array<std::size_t, 11> bins{};
-  for (double q : values)
-    for (std::size_t b = 0; b < bins.size(); ++b)
-      if (q >= kEdges[b] && q < kEdges[b + 1]) ++bins[b];
-  for (std::size_t b = 0; b < bins.size(); ++b) {
-    const std::string label = b == 0 ? "< 0" : b + 1 == bins.size() ? ">= 0.9" : fmt::format("[{:.1f}, {:.1f})", kEdges[b], kEdges[b + 1]);
-    const std::size_t width = values.empty() ? 0 : (bins[b] * 40 + values.size() - 1) / values.size();
-    out += fmt::format("  {:>12} {:>9} {}\n", label, bins[b], std::string(width, '#'));
+// Histogram lines (bars relative to the values counted).
+void histogram_lines(std::string& out, const QualityHistogram& h) {
+  for (std::size_t b = 0; b < QualityHistogram::kBins; ++b) {
+    const std::size_t width = h.values ? (h.bins[b] * 40 + h.values - 1) / h.values : 0;
+    out += fmt::format("  {:>12} {:>9} {}\n", QualityHistogram::label(b), h.bins[b], std::string(width, '#'));
   }
 }
 
 // The summary section of mu (sj = false) or the scaled Jacobian (sj = true).
-void quality_section(std::string& out, const CheckReport& r, bool sj, std::size_t worst) {
-  const QualityCounts& qc = sj ? r.sj_counts : r.mu_counts;
+void quality_section(std::string& out, const CheckSummary& r, bool sj, std::size_t worst) {
+  const QualitySummary& qs = sj ? r.sj : r.mu;
+  const QualityCounts& qc = qs.counts;
   const char* name = sj ? "scaled Jacobian" : "mu";
-  std::vector<double> lows;
-  double sum = 0;
-  for (std::size_t i = 0; i < r.elements.size(); ++i) {
-    const double lo = (sj ? r.sj_of(i) : r.mu_of(i)).lower;
-    if (std::isnan(lo)) continue;
-    lows.push_back(lo);
-    sum += lo;
-  }
   out += fmt::format("  {} ({}): computed {}, skipped {}, tolerance not met {}\n", name,
                      sj ? "min of det J / product of column norms, corner frames for simplices"
                         : "min of sqrt(lambda_min / lambda_max) of W^T W, Paper V",
@@ -61,27 +46,119 @@ void quality_section(std::string& out, const CheckReport& r, bool sj, std::size_
     const ElementType* t = find_element_type(id);
     out += fmt::format("  note: {} {} skipped for {}: type or order not supported\n", n, t ? t->name : "?", name);
   }
-  if (lows.empty()) {
+  const std::vector<WorstElement> wl = qs.worst.sorted();
+  if (qs.histogram.values == 0 || wl.empty()) {
     out += "\n";
     return;
   }
-  const std::size_t lowest = r.worst_quality(1, sj).front();
-  out += fmt::format("  {} lower bounds: min {:.6g} (element {}), mean {:.6g}\n", name,
-                     (sj ? r.sj_of(lowest) : r.mu_of(lowest)).lower, r.elements[lowest].tag, sum / static_cast<double>(lows.size()));
+  out += fmt::format("  {} lower bounds: min {:.6g} (element {}), mean {:.6g}\n", name, wl.front().quality.lower,
+                     wl.front().tag, qs.lower_sum / static_cast<double>(qs.histogram.values));
   out += fmt::format("  histogram of the {} lower bounds\n", name);
-  histogram(out, lows);
-  const auto wl = r.worst_quality(worst, sj);
-  if (!wl.empty()) {
-    out += fmt::format("  worst {} elements by {}\n", wl.size(), name);
+  histogram_lines(out, qs.histogram);
+  const std::size_t n = std::min(worst, wl.size());
+  if (n > 0) {
+    out += fmt::format("  worst {} elements by {}\n", n, name);
     out += fmt::format("  {:>10} {:<22} {:<13} {:>13} {:>13} {:>8}\n", "tag", "type", "validity", "lower", "upper", "subdiv");
-    for (std::size_t i : wl) {
-      const ElementCheck& e = r.elements[i];
-      const QualityBounds q = sj ? r.sj_of(i) : r.mu_of(i);
-      out += fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>8}\n", e.tag, e.type->name, answer(e), q.lower,
-                         q.upper, q.subdivisions);
+    for (std::size_t k = 0; k < n; ++k) {
+      const WorstElement& e = wl[k];
+      out += fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>8}\n", e.tag, e.type->name,
+                         validity_name(e.bounds.validity), e.quality.lower, e.quality.upper, e.quality.subdivisions);
     }
   }
   out += "\n";
+}
+
+// One element's JSON object (check_json's "elements" entries).
+nlohmann::json element_json(const ElementCheck& e, const DistortionBounds& d, const QualityBounds& mu,
+                            const QualityBounds& sj) {
+  using nlohmann::json;
+  const auto jnum = [](double x) { return std::isnan(x) ? json(nullptr) : json(x); };
+  const JacobianBounds& b = e.bounds;
+  json je = {{"tag", e.tag}, {"type", e.type->gmsh_id}, {"validity", answer(e)}};
+  if (e.analysed) {
+    je["jmin"] = {jnum(b.jmin_lower), jnum(b.jmin_upper)};
+    je["jmax"] = {jnum(b.jmax_lower), jnum(b.jmax_upper)};
+    je["distortion"] = {jnum(d.lower), jnum(d.upper)};
+    je["ratio_lower"] = jnum(e.ratio_lower());
+    je["jmin_over_javg"] = jnum(e.jmin_over_javg());
+    je["subdivisions"] = b.subdivisions;
+    je["stage"] = b.stage;
+    je["exact"] = b.exact;
+    for (const auto& [name, q] : {std::pair{"mu", mu}, std::pair{"sj", sj}})
+      if (!std::isnan(q.lower))
+        je[name] = {{"lower", q.lower}, {"upper", q.upper}, {"subdivisions", q.subdivisions},
+                    {"tolerance_met", q.tolerance_met}};
+  }
+  return je;
+}
+
+// check_json's "summary" object.
+nlohmann::json summary_json(const CheckSummary& r) {
+  using nlohmann::json;
+  json summary = {{"file", r.file},
+                  {"measure", measure_name(r.measure)},
+                  {"dimension", r.dimension},
+                  {"planar", r.planar},
+                  {"elements", r.elements},
+                  {"valid", r.count(Validity::valid)},
+                  {"invalid", r.count(Validity::invalid)},
+                  {"undetermined", r.count(Validity::undetermined)},
+                  {"skipped", r.skipped()},
+                  {"exact_fallbacks", r.exact_fallbacks},
+                  {"seconds", r.seconds},
+                  {"threads", r.threads}};
+  json types = json::object();
+  for (const auto& [id, c] : r.counts) {
+    const ElementType* t = find_element_type(id);
+    types[std::string(t ? t->name : "?")] = {{"gmsh_type", id}, {"valid", c[0]}, {"invalid", c[1]},
+                                             {"undetermined", c[2]}, {"skipped", c[3]}};
+  }
+  summary["types"] = types;
+  const auto first_tags = [](const WorstList& list) {
+    json tags = json::array();
+    const std::vector<WorstElement> w = list.sorted();
+    for (std::size_t k = 0; k < std::min<std::size_t>(10, w.size()); ++k) tags.push_back(w[k].tag);
+    return tags;
+  };
+  for (const auto& [key, qs, on] : {std::tuple{"mu", &r.mu, measures_mu(r.measure)},
+                                    std::tuple{"scaled_jacobian", &r.sj, measures_scaled_jacobian(r.measure)}}) {
+    if (!on) continue;
+    const QualityCounts& qc = qs->counts;
+    json q = {{"computed", qc.computed}, {"skipped", qc.skipped}, {"tolerance_not_met", qc.tolerance_not_met}};
+    q["worst_tags"] = first_tags(qs->worst);
+    summary[key] = q;
+  }
+  json stages = json::array();
+  for (const StageRow& s : r.stages)
+    stages.push_back({{"stage", s.name}, {"valid", s.valid}, {"invalid", s.invalid}, {"cpu_seconds", s.seconds}});
+  summary["stages"] = stages;
+  summary["worst_tags"] = first_tags(r.worst);
+  return summary;
+}
+
+// One CSV row (check_csv).
+void csv_row(std::string& out, const ElementCheck& e, const DistortionBounds& d, const QualityBounds& mu,
+             const QualityBounds& sj) {
+  const JacobianBounds& b = e.bounds;
+  if (!e.analysed) {
+    out += fmt::format("{},{},skipped,nan,nan,nan,nan,nan,0,nan,nan,nan,-1,0,nan,nan,nan,nan\n", e.tag, e.type->gmsh_id);
+    return;
+  }
+  out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag, e.type->gmsh_id, answer(e),
+                     num(b.jmin_lower), num(b.jmin_upper), num(b.jmax_lower), num(b.jmax_upper), num(d.lower),
+                     b.subdivisions, num(d.upper), num(e.jmin_over_javg()), num(e.ratio_lower()), b.stage,
+                     b.exact ? 1 : 0, num(mu.lower), num(mu.upper), num(sj.lower), num(sj.upper));
+}
+
+// `text` with `pad` spaces after every line break (nesting a dump(1) one level deeper).
+std::string indented(const std::string& text, const std::string& pad) {
+  std::string out;
+  out.reserve(text.size() + text.size() / 8);
+  for (char c : text) {
+    out += c;
+    if (c == '\n') out += pad;
+  }
+  return out;
 }
 
 }  // namespace
@@ -108,11 +185,11 @@ bool measures_distortion(CheckMeasure m) noexcept {
   return m == CheckMeasure::distortion || m == CheckMeasure::all;
 }
 
-std::string format_check_summary(const CheckReport& r, std::size_t worst) {
+std::string format_check_summary(const CheckSummary& r, std::size_t worst) {
   std::string out;
   auto line = [&out](const std::string& s) { out += s + "\n"; };
   line(fmt::format("[check] {}: {} elements of dimension {}{}, measure {}, {} thread{}, {:.3f} s",
-                   r.file, r.elements.size(), r.dimension,
+                   r.file, r.elements, r.dimension,
                    r.dimension == 2 ? (r.planar ? " (planar: J with n = +z)" : " (J with each element's normal)") : "",
                    measure_name(r.measure), r.threads, r.threads == 1 ? "" : "s", r.seconds));
   line(fmt::format("[check] valid {}, invalid {}, undetermined {}, skipped {}", r.count(Validity::valid),
@@ -140,40 +217,23 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   line("");
 
   // Histogram of the scale-free quality.
-  const char* qname = measures_distortion(r.measure) ? "distortion lower bound (min J / J_straight)"
-                                                            : "min J / max J lower bound";
-  static constexpr double kEdges[] = {-INFINITY, 0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, INFINITY};
-  std::array<std::size_t, 11> bins{};
-  std::size_t undefined = 0, total = 0;
-  for (std::size_t i = 0; i < r.elements.size(); ++i) {
-    if (!r.elements[i].analysed) continue;
-    const double q = quality(r, i);
-    if (std::isnan(q)) {
-      ++undefined;
-      continue;
-    }
-    ++total;
-    for (std::size_t b = 0; b < bins.size(); ++b)
-      if (q >= kEdges[b] && q < kEdges[b + 1]) ++bins[b];
-  }
-  line(fmt::format("  histogram of the {}", qname));
-  for (std::size_t b = 0; b < bins.size(); ++b) {
-    const std::string label = b == 0 ? "< 0" : b + 1 == bins.size() ? ">= 0.9" : fmt::format("[{:.1f}, {:.1f})", kEdges[b], kEdges[b + 1]);
-    const std::size_t width = total ? (bins[b] * 40 + total - 1) / total : 0;
-    line(fmt::format("  {:>12} {:>9} {}", label, bins[b], std::string(width, '#')));
-  }
-  if (undefined) line(fmt::format("  {:>12} {:>9}", "undefined", undefined));
+  const bool by_distortion = measures_distortion(r.measure);
+  line(fmt::format("  histogram of the {}", by_distortion ? "distortion lower bound (min J / J_straight)"
+                                                          : "min J / max J lower bound"));
+  histogram_lines(out, r.histogram);
+  if (r.histogram.undefined) line(fmt::format("  {:>12} {:>9}", "undefined", r.histogram.undefined));
   line("");
 
-  const auto w = r.worst(worst);
-  if (!w.empty()) {
-    line(fmt::format("  worst {} elements", w.size()));
+  const std::vector<WorstElement> w = r.worst.sorted();
+  const std::size_t n = std::min(worst, w.size());
+  if (n > 0) {
+    line(fmt::format("  worst {} elements", n));
     line(fmt::format("  {:>10} {:<22} {:<13} {:>13} {:>13} {:>11}", "tag", "type", "validity", "jmin_lower",
-                     "jmin_upper", measures_distortion(r.measure) ? "distortion" : "ratio"));
-    for (std::size_t i : w) {
-      const ElementCheck& e = r.elements[i];
-      line(fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>11.5g}", e.tag, e.type->name, answer(e),
-                       e.bounds.jmin_lower, e.bounds.jmin_upper, quality(r, i)));
+                     "jmin_upper", by_distortion ? "distortion" : "ratio"));
+    for (std::size_t k = 0; k < n; ++k) {
+      const WorstElement& e = w[k];
+      line(fmt::format("  {:>10} {:<22} {:<13} {:>13.6g} {:>13.6g} {:>11.5g}", e.tag, e.type->name,
+                       validity_name(e.bounds.validity), e.bounds.jmin_lower, e.bounds.jmin_upper, e.key));
     }
   }
   const bool mu = measures_mu(r.measure), sj = measures_scaled_jacobian(r.measure);
@@ -187,91 +247,49 @@ std::string format_check_summary(const CheckReport& r, std::size_t worst) {
   return out;
 }
 
+std::string format_check_summary(const CheckReport& report, std::size_t worst) {
+  return format_check_summary(summarize(report, worst), worst);
+}
+
+std::string check_csv_header() {
+  return "tag,type,validity,jmin_lower,jmin_upper,jmax_lower,jmax_upper,distortion_lower,subdivisions,"
+         "distortion_upper,jmin_over_javg,ratio_lower,stage,exact,mu_lower,mu_upper,sj_lower,sj_upper\n";
+}
+
+void append_check_csv_rows(std::string& out, const CheckBatch& b) {
+  for (std::size_t i = 0; i < b.elements.size(); ++i) csv_row(out, b.elements[i], b.distortion_of(i), b.mu_of(i), b.sj_of(i));
+}
+
 std::string check_csv(const CheckReport& r) {
-  std::string out =
-      "tag,type,validity,jmin_lower,jmin_upper,jmax_lower,jmax_upper,distortion_lower,subdivisions,"
-      "distortion_upper,jmin_over_javg,ratio_lower,stage,exact,mu_lower,mu_upper,sj_lower,sj_upper\n";
-  for (std::size_t i = 0; i < r.elements.size(); ++i) {
-    const ElementCheck& e = r.elements[i];
-    const JacobianBounds& b = e.bounds;
-    const DistortionBounds d = r.distortion_of(i);
-    const QualityBounds mu = r.mu_of(i), sj = r.sj_of(i);
-    if (!e.analysed) {
-      out += fmt::format("{},{},skipped,nan,nan,nan,nan,nan,0,nan,nan,nan,-1,0,nan,nan,nan,nan\n", e.tag, e.type->gmsh_id);
-      continue;
-    }
-    out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag, e.type->gmsh_id, answer(e),
-                       num(b.jmin_lower), num(b.jmin_upper), num(b.jmax_lower), num(b.jmax_upper),
-                       num(d.lower), b.subdivisions, num(d.upper),
-                       num(e.jmin_over_javg()), num(e.ratio_lower()), b.stage, b.exact ? 1 : 0, num(mu.lower),
-                       num(mu.upper), num(sj.lower), num(sj.upper));
-  }
+  std::string out = check_csv_header();
+  for (std::size_t i = 0; i < r.elements.size(); ++i) csv_row(out, r.elements[i], r.distortion_of(i), r.mu_of(i), r.sj_of(i));
   return out;
 }
 
 std::string check_json(const CheckReport& r) {
   using nlohmann::json;
-  const auto jnum = [](double x) { return std::isnan(x) ? json(nullptr) : json(x); };
-  json summary = {{"file", r.file},
-                  {"measure", measure_name(r.measure)},
-                  {"dimension", r.dimension},
-                  {"planar", r.planar},
-                  {"elements", r.elements.size()},
-                  {"valid", r.count(Validity::valid)},
-                  {"invalid", r.count(Validity::invalid)},
-                  {"undetermined", r.count(Validity::undetermined)},
-                  {"skipped", r.skipped()},
-                  {"exact_fallbacks", r.exact_fallbacks},
-                  {"seconds", r.seconds},
-                  {"threads", r.threads}};
-  json types = json::object();
-  for (const auto& [id, c] : r.counts) {
-    const ElementType* t = find_element_type(id);
-    types[std::string(t ? t->name : "?")] = {{"gmsh_type", id}, {"valid", c[0]}, {"invalid", c[1]},
-                                             {"undetermined", c[2]}, {"skipped", c[3]}};
-  }
-  summary["types"] = types;
-  for (const auto& [key, qc, on] : {std::tuple{"mu", &r.mu_counts, measures_mu(r.measure)},
-                                    std::tuple{"scaled_jacobian", &r.sj_counts, measures_scaled_jacobian(r.measure)}}) {
-    if (!on) continue;
-    json q = {{"computed", qc->computed}, {"skipped", qc->skipped}, {"tolerance_not_met", qc->tolerance_not_met}};
-    const auto w = r.worst_quality(10, std::string(key) != "mu");
-    json tags = json::array();
-    for (std::size_t i : w) tags.push_back(r.elements[i].tag);
-    q["worst_tags"] = tags;
-    summary[key] = q;
-  }
-  json stages = json::array();
-  for (const StageRow& s : r.stages)
-    stages.push_back({{"stage", s.name}, {"valid", s.valid}, {"invalid", s.invalid}, {"cpu_seconds", s.seconds}});
-  summary["stages"] = stages;
-  json worst = json::array();
-  for (std::size_t i : r.worst(10)) worst.push_back(r.elements[i].tag);
-  summary["worst_tags"] = worst;
   json elements = json::array();
-  for (std::size_t i = 0; i < r.elements.size(); ++i) {
-    const ElementCheck& e = r.elements[i];
-    const JacobianBounds& b = e.bounds;
-    const DistortionBounds d = r.distortion_of(i);
-    const QualityBounds mu = r.mu_of(i), sj = r.sj_of(i);
-    json je = {{"tag", e.tag}, {"type", e.type->gmsh_id}, {"validity", answer(e)}};
-    if (e.analysed) {
-      je["jmin"] = {jnum(b.jmin_lower), jnum(b.jmin_upper)};
-      je["jmax"] = {jnum(b.jmax_lower), jnum(b.jmax_upper)};
-      je["distortion"] = {jnum(d.lower), jnum(d.upper)};
-      je["ratio_lower"] = jnum(e.ratio_lower());
-      je["jmin_over_javg"] = jnum(e.jmin_over_javg());
-      je["subdivisions"] = b.subdivisions;
-      je["stage"] = b.stage;
-      je["exact"] = b.exact;
-      for (const auto& [name, q] : {std::pair{"mu", mu}, std::pair{"sj", sj}})
-        if (!std::isnan(q.lower))
-          je[name] = {{"lower", q.lower}, {"upper", q.upper}, {"subdivisions", q.subdivisions},
-                      {"tolerance_met", q.tolerance_met}};
-    }
-    elements.push_back(std::move(je));
+  for (std::size_t i = 0; i < r.elements.size(); ++i)
+    elements.push_back(element_json(r.elements[i], r.distortion_of(i), r.mu_of(i), r.sj_of(i)));
+  return json({{"summary", summary_json(summarize(r, 10))}, {"elements", elements}}).dump(1) + "\n";
+}
+
+// The layout of json::dump(1) for {"elements": [...], "summary": {...}} (keys sorted), one
+// element at a time: each element is dumped alone and indented two levels deeper.
+CheckJsonWriter::CheckJsonWriter(std::ostream& out) : out_(&out) { *out_ << "{\n \"elements\": ["; }
+
+void CheckJsonWriter::add(const CheckBatch& b) {
+  std::string text;
+  for (std::size_t i = 0; i < b.elements.size(); ++i) {
+    text += any_ ? ",\n  " : "\n  ";
+    any_ = true;
+    text += indented(element_json(b.elements[i], b.distortion_of(i), b.mu_of(i), b.sj_of(i)).dump(1), "  ");
   }
-  return json({{"summary", summary}, {"elements", elements}}).dump(1) + "\n";
+  *out_ << text;
+}
+
+void CheckJsonWriter::finish(const CheckSummary& summary) {
+  *out_ << (any_ ? "\n ]" : "]") << ",\n \"summary\": " << indented(summary_json(summary).dump(1), " ") << "\n}\n";
 }
 
 std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh& mesh,
@@ -309,6 +327,50 @@ std::vector<std::pair<std::string, std::vector<double>>> check_fields(const Mesh
   if (!measures_scaled_jacobian(r.measure)) f.erase(f.begin() + 6);
   if (!measures_mu(r.measure)) f.erase(f.begin() + 5);
   return f;
+}
+
+CheckFieldCollector::CheckFieldCollector(const Mesh& mesh, CheckMeasure measure) : measure_(measure) {
+  const std::size_t n = mesh.num_elements();
+  fields_ = {{"validity", {}}, {"jmin_lower", {}}, {"jmin_upper", {}}, {"ratio_lower", {}},
+             {"distortion_lower", {}}, {"mu_lower", {}}, {"sj_lower", {}}};
+  // mu_lower and sj_lower only when the measure computes them (as check_fields).
+  if (!measures_scaled_jacobian(measure)) fields_.erase(fields_.begin() + 6);
+  if (!measures_mu(measure)) fields_.erase(fields_.begin() + 5);
+  for (auto& [name, values] : fields_) values.assign(n, NAN);
+  const int dim = mesh.dimension();
+  std::size_t first = 0, offset = 0;
+  for (const ElementBlock& b : mesh.blocks) {
+    if (b.type->dim == dim) {
+      runs_.push_back({first, b.size(), offset});
+      first += b.size();
+    }
+    offset += b.size();
+  }
+}
+
+void CheckFieldCollector::add(const CheckBatch& batch) {
+  for (std::size_t i = 0; i < batch.elements.size(); ++i) {
+    const ElementCheck& c = batch.elements[i];
+    if (!c.analysed) continue;  // NaN everywhere, as initialised
+    const std::size_t g = batch.first + i;
+    // The run holding analysed element g: the last one starting at or before it.
+    const auto run = std::prev(std::upper_bound(runs_.begin(), runs_.end(), g,
+                                                [](std::size_t x, const Run& r) { return x < r.first; }));
+    const std::size_t at = run->offset + (g - run->first);
+    const double values[7] = {
+        c.bounds.validity == Validity::valid ? 1.0 : c.bounds.validity == Validity::invalid ? -1.0 : 0.0,
+        c.bounds.jmin_lower, c.bounds.jmin_upper, c.ratio_lower(), batch.distortion_of(i).lower,
+        batch.mu_of(i).lower, batch.sj_of(i).lower};
+    std::size_t f = 0;
+    for (std::size_t k = 0; k < 7; ++k) {
+      if ((k == 5 && !measures_mu(measure_)) || (k == 6 && !measures_scaled_jacobian(measure_))) continue;
+      fields_[f++].second[at] = values[k];
+    }
+  }
+}
+
+std::vector<std::pair<std::string, std::vector<double>>> CheckFieldCollector::take() {
+  return std::move(fields_);
 }
 
 }  // namespace quadval

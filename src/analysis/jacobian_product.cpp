@@ -28,6 +28,7 @@
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
 #include "analysis/jacobian_samples.hpp"
+#include "analysis/product_tables.hpp"
 #include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "bezier/rational_rounding.hpp"
@@ -76,10 +77,12 @@ int snap(double x, int p, bool interval) {
 
 }  // namespace
 
-JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& basis)
+JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& basis,
+                                 TableSource source)
     : type_(&type), basis_(&basis), dim_(type.dim), order_(type.order) {
   if (type.family == ElementFamily::pyramid) {
-    init_pyramid();
+    init_pyramid();  // exact data and tables at once (src/analysis/pyramid_space.cpp)
+    std::call_once(exact_once_, [] {});
     build_kernel_tables();
     return;
   }
@@ -110,55 +113,12 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
   };
   lattice_ = space_of({p, p, p});
 
-  // Exact per-factor derivative maps (scaled rows): factor h != f(c): mult(a) T_h[a][l];
-  // factor f(c): mult(b) s p (T[b + e_c][l] - T[b + e_0][l]), s = 1/2 on [-1, 1] axes.
+  // Direction c's derivative space: degree p - 1 in its own factor, p in the others.
   for (int c = 0; c < dim_; ++c) {
     const auto cs = static_cast<std::size_t>(c);
-    const int f = direction_factor_[cs];
     std::array<int, 3> deg{p, p, p};
-    deg[static_cast<std::size_t>(f)] = p - 1;
+    deg[static_cast<std::size_t>(direction_factor_[cs])] = p - 1;
     deriv_space_[cs] = space_of(deg);
-    for (int h = 0; h < num_factors_; ++h) {
-      const auto hs = static_cast<std::size_t>(h);
-      const int d = factor_dim_[hs];
-      const BernsteinSimplex& geo = bernstein_simplex(d, p);
-      const auto& t = geo.exact().to_bezier;
-      const auto lat = simplex_multi_indices(d, p);
-      const auto ls = lat.size();
-      auto& m = factor_matrix_[cs][hs];
-      if (h != f) {
-        m.resize(ls * ls);
-        for (std::size_t a = 0; a < ls; ++a)
-          for (std::size_t l = 0; l < ls; ++l) m[a * ls + l] = multinomial(lat[a]) * t[a * ls + l];
-      } else {
-        const auto rows = simplex_multi_indices(d, p - 1);
-        m.resize(rows.size() * ls);
-        const mpq_class scale = factor_interval_[hs] ? frac(p, 2) : mpq_class(p);
-        const int local = direction_local_[cs];
-        for (std::size_t b = 0; b < rows.size(); ++b) {
-          MultiIndex plus = rows[b], zero = rows[b];
-          ++plus[static_cast<std::size_t>(local)];
-          ++zero[0];
-          const auto ip = static_cast<std::size_t>(index_of(lat, plus));
-          const auto iz = static_cast<std::size_t>(index_of(lat, zero));
-          const mpq_class w = scale * multinomial(rows[b]);
-          for (std::size_t l = 0; l < ls; ++l) m[b * ls + l] = w * (t[ip * ls + l] - t[iz * ls + l]);
-        }
-      }
-    }
-    auto& inv = deriv_inv_mult_[cs];
-    inv.resize(static_cast<std::size_t>(deriv_space_[cs].total));
-    for (int k = 0; k < deriv_space_[cs].total; ++k) {
-      mpz_class w = 1;
-      int rest = k;
-      for (int h = 0; h < num_factors_; ++h) {
-        const auto hs = static_cast<std::size_t>(h);
-        const auto idx = simplex_multi_indices(factor_dim_[hs], deg[hs]);
-        w *= multinomial(idx[static_cast<std::size_t>(rest % deriv_space_[cs].size[hs])]);
-        rest /= deriv_space_[cs].size[hs];
-      }
-      inv[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(w));
-    }
   }
 
   // The J space: it must be the basis's, factor by factor, in the same enumeration.
@@ -171,15 +131,6 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
   }
   const Space jspace = space_of(jdeg);
   QV_ASSERT(jspace.total == basis.size(), "J space size");
-  mult_.resize(static_cast<std::size_t>(jspace.total));
-  inv_mult_.resize(mult_.size());
-  for (int k = 0; k < jspace.total; ++k) {
-    mpz_class w = 1;
-    for (int h = 0; h < num_factors_; ++h)
-      w *= multinomial(basis.factors()[static_cast<std::size_t>(h)]->multi_indices()[static_cast<std::size_t>(basis.factor_index(k, h))]);
-    mult_[static_cast<std::size_t>(k)] = w;
-    inv_mult_[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(w));
-  }
 
   // The convolutions, and the rounding constant of the model above.
   if (dim_ == 3) {
@@ -219,9 +170,132 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
       lattice_of_node_[i] = l;
     }
   }
-  build_map(SampleMap::curved);
-  build_map(SampleMap::straight);
+  maps_[0].num_nodes = type.num_nodes;
+  maps_[1].num_nodes = family_num_vertices(type.family);
+
+  // The rounded tables: generated at build time for common types (product_tables.hpp),
+  // else rounded here from the exact data, which the generated path builds only when the
+  // exact fallback first asks for it (exact_coefficients).
+  const ProductTableView* generated =
+      source == TableSource::generated_or_exact ? generated_product_tables(type.gmsh_id) : nullptr;
+  if (generated != nullptr) {
+    load_tables(*generated);
+  } else {
+    build_exact();
+    build_rounded_tables();
+  }
   build_kernel_tables();
+}
+
+void JacobianProduct::build_exact() const {
+  std::call_once(exact_once_, [this] { build_exact_data(); });
+}
+
+void JacobianProduct::build_exact_data() const {
+  const int p = order_;
+  const BezierBasis& basis = *basis_;
+  // Exact per-factor derivative maps (scaled rows): factor h != f(c): mult(a) T_h[a][l];
+  // factor f(c): mult(b) s p (T[b + e_c][l] - T[b + e_0][l]), s = 1/2 on [-1, 1] axes.
+  for (int c = 0; c < dim_; ++c) {
+    const auto cs = static_cast<std::size_t>(c);
+    const int f = direction_factor_[cs];
+    for (int h = 0; h < num_factors_; ++h) {
+      const auto hs = static_cast<std::size_t>(h);
+      const int d = factor_dim_[hs];
+      const BernsteinSimplex& geo = bernstein_simplex(d, p);
+      const auto& t = geo.exact().to_bezier;
+      const auto lat = simplex_multi_indices(d, p);
+      const auto ls = lat.size();
+      auto& m = factor_matrix_[cs][hs];
+      if (h != f) {
+        m.resize(ls * ls);
+        for (std::size_t a = 0; a < ls; ++a)
+          for (std::size_t l = 0; l < ls; ++l) m[a * ls + l] = multinomial(lat[a]) * t[a * ls + l];
+      } else {
+        const auto rows = simplex_multi_indices(d, p - 1);
+        m.resize(rows.size() * ls);
+        const mpq_class scale = factor_interval_[hs] ? frac(p, 2) : mpq_class(p);
+        const int local = direction_local_[cs];
+        for (std::size_t b = 0; b < rows.size(); ++b) {
+          MultiIndex plus = rows[b], zero = rows[b];
+          ++plus[static_cast<std::size_t>(local)];
+          ++zero[0];
+          const auto ip = static_cast<std::size_t>(index_of(lat, plus));
+          const auto iz = static_cast<std::size_t>(index_of(lat, zero));
+          const mpq_class w = scale * multinomial(rows[b]);
+          for (std::size_t l = 0; l < ls; ++l) m[b * ls + l] = w * (t[ip * ls + l] - t[iz * ls + l]);
+        }
+      }
+    }
+  }
+  // mult(gamma) of the J space.
+  mult_.resize(static_cast<std::size_t>(basis.size()));
+  for (int k = 0; k < basis.size(); ++k) {
+    mpz_class w = 1;
+    for (int h = 0; h < num_factors_; ++h)
+      w *= multinomial(basis.factors()[static_cast<std::size_t>(h)]->multi_indices()[static_cast<std::size_t>(basis.factor_index(k, h))]);
+    mult_[static_cast<std::size_t>(k)] = w;
+  }
+  build_lattice_values(SampleMap::curved);
+  build_lattice_values(SampleMap::straight);
+}
+
+void JacobianProduct::build_rounded_tables() {
+  // 1 / mult(k) of the derivative spaces and of the J space, rounded to nearest.
+  for (int c = 0; c < dim_; ++c) {
+    const auto cs = static_cast<std::size_t>(c);
+    const std::array<int, 3> deg = deriv_space_[cs].degree;
+    auto& inv = deriv_inv_mult_[cs];
+    inv.resize(static_cast<std::size_t>(deriv_space_[cs].total));
+    for (int k = 0; k < deriv_space_[cs].total; ++k) {
+      mpz_class w = 1;
+      int rest = k;
+      for (int h = 0; h < num_factors_; ++h) {
+        const auto hs = static_cast<std::size_t>(h);
+        const auto idx = simplex_multi_indices(factor_dim_[hs], deg[hs]);
+        w *= multinomial(idx[static_cast<std::size_t>(rest % deriv_space_[cs].size[hs])]);
+        rest /= deriv_space_[cs].size[hs];
+      }
+      inv[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(w));
+    }
+  }
+  inv_mult_.resize(mult_.size());
+  for (std::size_t k = 0; k < mult_.size(); ++k) inv_mult_[k] = nearest_double(mpq_class(1) / mpq_class(mult_[k]));
+  build_map_tables(SampleMap::curved);
+  build_map_tables(SampleMap::straight);
+}
+
+ProductTables JacobianProduct::tables() const {
+  ProductTables t;
+  for (std::size_t m = 0; m < 2; ++m) {
+    t.maps[m].num_nodes = maps_[m].num_nodes;
+    t.maps[m].matrix = maps_[m].matrix;
+    t.maps[m].row_sum = maps_[m].row_sum;
+  }
+  t.deriv_inv_mult = deriv_inv_mult_;
+  t.inv_mult = inv_mult_;
+  return t;
+}
+
+void JacobianProduct::load_tables(const ProductTableView& g) {
+  const auto expect_size = [&](std::span<const double> v, std::size_t n) {
+    QV_ASSERT(v.size() == n, "generated tables of " << type_->name << " have " << v.size() << " entries, expected " << n);
+    return std::vector<double>(v.begin(), v.end());
+  };
+  for (std::size_t m = 0; m < 2; ++m) {
+    Map& map = maps_[m];
+    QV_ASSERT(g.num_nodes[m] == map.num_nodes, "generated tables of " << type_->name << ": node count");
+    for (int c = 0; c < dim_; ++c) {
+      const auto cs = static_cast<std::size_t>(c);
+      map.matrix[cs] = expect_size(g.matrix[m][cs], static_cast<std::size_t>(deriv_space_[cs].total) * static_cast<std::size_t>(map.num_nodes));
+      map.row_sum[cs] = g.row_sum[m][cs];
+    }
+  }
+  for (int c = 0; c < dim_; ++c) {
+    const auto cs = static_cast<std::size_t>(c);
+    deriv_inv_mult_[cs] = expect_size(g.deriv_inv_mult[cs], static_cast<std::size_t>(deriv_space_[cs].total));
+  }
+  inv_mult_ = expect_size(g.inv_mult, static_cast<std::size_t>(basis_->size()));
 }
 
 JacobianProduct::Product JacobianProduct::make_product(const Space& a, const Space& b,
@@ -294,7 +368,7 @@ std::vector<mpq_class> JacobianProduct::exact_derivative(int c, const std::vecto
   return in;
 }
 
-void JacobianProduct::build_map(SampleMap which) {
+void JacobianProduct::build_lattice_values(SampleMap which) const {
   Map& map = maps_[static_cast<std::size_t>(which)];
   const int p = order_;
   const auto lat = static_cast<std::size_t>(lattice_.total);
@@ -302,7 +376,6 @@ void JacobianProduct::build_map(SampleMap which) {
   if (which == SampleMap::straight) {
     const ElementType& linear = *find_element_type(type_->family, 1, true);
     const auto ref = reference_nodes(linear);
-    map.num_nodes = static_cast<int>(ref.size());
     map.to_lattice.assign(lat * ref.size(), mpq_class(0));
     for (std::size_t v = 0; v < ref.size(); ++v) {
       // vertex v: which barycentric component is 1 in each factor
@@ -336,7 +409,6 @@ void JacobianProduct::build_map(SampleMap which) {
     const detail::PolynomialSpace space = detail::polynomial_space(*type_, detail::FactorBasis::monomial);
     const auto ref = reference_nodes(*type_);
     const std::size_t n = ref.size();
-    map.num_nodes = static_cast<int>(n);
     const auto power = [](const mpq_class& x, int e) {
       mpq_class r = 1;
       for (int k = 0; k < e; ++k) r *= x;
@@ -386,12 +458,14 @@ void JacobianProduct::build_map(SampleMap which) {
         map.to_lattice[l * n + i] = s;
       }
     }
-  } else {
-    map.num_nodes = type_->num_nodes;
   }
+}
 
+void JacobianProduct::build_map_tables(SampleMap which) {
+  Map& map = maps_[static_cast<std::size_t>(which)];
   // Rounded derivative maps and their row sums.
   const auto n = static_cast<std::size_t>(map.num_nodes);
+  const auto lat = static_cast<std::size_t>(lattice_.total);
   for (int c = 0; c < dim_; ++c) {
     const auto cs = static_cast<std::size_t>(c);
     const auto rows = static_cast<std::size_t>(deriv_space_[cs].total);
@@ -668,6 +742,7 @@ void JacobianProduct::coefficients(SampleMap which, const double* nodes, std::si
 
 std::vector<mpq_class> JacobianProduct::exact_coefficients(SampleMap which, const double* nodes,
                                                            bool planar) const {
+  build_exact();
   const Map& map = maps_[static_cast<std::size_t>(which)];
   const auto n = static_cast<std::size_t>(map.num_nodes);
   const auto lat = static_cast<std::size_t>(lattice_.total);

@@ -36,6 +36,28 @@ struct PyramidShapeCoefficients;  // pyramid_space.hpp
 /// Which geometry to use: the element's own map, or its straight-sided element's.
 enum class SampleMap { curved, straight };
 
+/// The rounded tables of a JacobianProduct: everything its double arithmetic reads that
+/// is rounded from exact rationals. Generated at build time for common types
+/// (product_tables.hpp), else rounded when the product is built.
+struct ProductTables {
+  struct MapTables {
+    int num_nodes = 0;
+    std::array<std::vector<double>, 3> matrix;  ///< direction c: rows(c) x num_nodes, scaled rows
+    std::array<double, 3> row_sum{0, 0, 0};     ///< max_k sum_i |exact entry| / mult(k), rounded up
+  };
+  std::array<MapTables, 2> maps;                   ///< SampleMap::curved, SampleMap::straight
+  std::array<std::vector<double>, 3> deriv_inv_mult;  ///< 1 / mult(k) of each derivative space
+  std::vector<double> inv_mult;                    ///< 1 / mult(gamma) of the J space
+};
+
+struct ProductTableView;  // product_tables.hpp
+
+/// Where a JacobianProduct takes its rounded tables from.
+enum class TableSource {
+  generated_or_exact,  ///< the build-time tables when the type has them, else exact
+  exact,               ///< always round them here from the exact rationals (the generator, tests)
+};
+
 /// Scratch of JacobianProduct::coefficients, reused across calls.
 struct ProductScratch {
   std::vector<double> block;  // one lane block's coordinates, derivatives and cross products
@@ -46,9 +68,16 @@ class JacobianProduct {
   /// Elements computed together, one per SIMD lane (8 doubles: one AVX-512 register).
   static constexpr int kLanes = 8;
 
-  /// @pre type a Lagrange line, triangle, quadrangle, tetrahedron, prism or hexahedron;
-  ///      basis = bezier_basis(type.family, type.order)
-  JacobianProduct(const ElementType& type, const BezierBasis& basis);
+  /// @pre type a Lagrange line, triangle, quadrangle, tetrahedron, prism or hexahedron
+  ///      (or pyramid, src/analysis/pyramid_space.cpp); basis = bezier_basis(type.family,
+  ///      type.order)
+  /// With generated tables the exact rational data (GMP) is built only on the first
+  /// exact_coefficients call (thread-safe), so the set-up of a type costs microseconds.
+  JacobianProduct(const ElementType& type, const BezierBasis& basis,
+                  TableSource source = TableSource::generated_or_exact);
+
+  /// A copy of the rounded tables (what the generator writes, and what tests compare).
+  ProductTables tables() const;
 
   /// Nodes read per element: all of them (curved) or the vertices (straight).
   int num_nodes(SampleMap map) const noexcept { return maps_[static_cast<int>(map)].num_nodes; }
@@ -108,7 +137,12 @@ class JacobianProduct {
   Product make_product(const Space& a, const Space& b, const Space& c) const;
   template <class F>
   static void for_each_term(const Product& p, F&& f);
-  void build_map(SampleMap which);
+  void build_exact() const;       // the exact data below, once (thread-safe)
+  void build_exact_data() const;  // factor_matrix_, mult_, to_lattice
+  void build_lattice_values(SampleMap which) const;
+  void build_rounded_tables();    // from the exact data
+  void build_map_tables(SampleMap which);
+  void load_tables(const ProductTableView& generated);
   Gather make_gather(const Product& p, int outputs) const;
   void build_kernel_tables();  // gathers and sparse rows, once the products and maps exist
   // coefficients() of W consecutive elements (lanes), all arrays lane-fastest in buf.
@@ -133,16 +167,18 @@ class JacobianProduct {
   std::array<Space, 3> deriv_space_;
   std::array<std::vector<double>, 3> deriv_inv_mult_;  // 1 / mult(k), rounded to nearest
   std::vector<double> inv_mult_;                        // 1 / mult(gamma) of the J space
-  std::vector<mpz_class> mult_;                         // mult(gamma) of the J space
+  // Exact data, built by build_exact (mutable: lazily, under exact_once_).
+  mutable std::once_flag exact_once_;
+  mutable std::vector<mpz_class> mult_;                 // mult(gamma) of the J space
   // exact per-factor derivative maps: factor_matrix_[c][h] is rows x lattice size of factor h
-  std::array<std::array<std::vector<mpq_class>, 3>, 3> factor_matrix_;
+  mutable std::array<std::array<std::vector<mpq_class>, 3>, 3> factor_matrix_;
   std::vector<int> lattice_of_node_;  // complete types: lattice index of node i
   Product cross_;  // 3D: X_eta x X_zeta; 2D: X_xi x X_eta (then J)
   int cross_size_ = 0;  // 3D: coefficients of each component of X_eta x X_zeta
   Product dot_;    // 3D: X_xi . (X_eta x X_zeta)
   Gather cross_gather_, dot_gather_;  // cross_ and dot_ by output, same summation order
   double rounding_ = 0;  // relative rounding of the products and the final scaling
-  std::array<Map, 2> maps_;
+  mutable std::array<Map, 2> maps_;  // mutable for Map::to_lattice only (build_exact)
 };
 
 }  // namespace quadval

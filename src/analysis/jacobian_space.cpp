@@ -292,59 +292,81 @@ JacobianSpace::JacobianSpace(const ElementType& type)
   dim_ = type.dim;
   num_vertices_ = family_num_vertices(type.family);
   product_ = std::make_unique<const JacobianProduct>(type, *basis_);
-  if (type.order > sampled_max_order(type.family)) return;
-  const auto shapes = factor_shapes(type.family);
-  const auto s = static_cast<std::size_t>(num_samples_);
-  const auto n = static_cast<std::size_t>(num_nodes_);
+  sampled_ = type.order <= sampled_max_order(type.family);
+}
 
-  double row_sum = 0;
-  if (type.complete) {
-    // Double entries are products of rounded factor entries: relative error <= 2.5u
-    // (at most three factors rounded to nearest, two products, an exact halving).
-    std::vector<FactorMatrices> fm;
-    for (std::size_t f = 0; f < shapes.size(); ++f) fm.push_back(factor_matrices(*basis_->factors()[f], type.order));
-    const auto idx = node_factor_indices(type, type.order, reference_nodes(type), shapes, fm);
-    int c_global = 0;
-    for (std::size_t f = 0; f < shapes.size(); ++f) {
-      for (int c = 0; c < shapes[f].dim; ++c, ++c_global) {
-        auto& g = grad_[c_global];
-        g.assign(s * n, 0.0);
-        // rounded factor tables
-        std::vector<std::vector<double>> val(shapes.size()), der(shapes.size());
-        for (std::size_t h = 0; h < shapes.size(); ++h) {
-          for (const auto& q : fm[h].value) val[h].push_back(nearest_double(q));
-          for (const auto& q : fm[h].deriv[h == f ? c : 0]) der[h].push_back(nearest_double(q));
-        }
-        for (std::size_t k = 0; k < s; ++k)
-          for (std::size_t i = 0; i < n; ++i) {
-            double v = shapes[f].interval ? 0.5 : 1.0;
-            for (std::size_t h = 0; h < shapes.size(); ++h) {
-              const auto kh = static_cast<std::size_t>(basis_->factor_index(static_cast<int>(k), static_cast<int>(h)));
-              const auto ih = static_cast<std::size_t>(idx[i][h]);
-              const auto nh = static_cast<std::size_t>(fm[h].num_nodes);
-              v *= (h == f) ? der[h][kh * nh + ih] : val[h][kh * nh + ih];
-            }
-            g[k * n + i] = v;
+void JacobianSpace::build_gradients() const {
+  QV_ASSERT(sampled_, "no sample gradients for " << type_->name);
+  std::call_once(gradients_once_, [this] {
+    const ElementType& type = *type_;
+    const auto shapes = factor_shapes(type.family);
+    const auto s = static_cast<std::size_t>(num_samples_);
+    const auto n = static_cast<std::size_t>(num_nodes_);
+
+    double row_sum = 0;
+    if (type.complete) {
+      // Double entries are products of rounded factor entries: relative error <= 2.5u
+      // (at most three factors rounded to nearest, two products, an exact halving).
+      std::vector<FactorMatrices> fm;
+      for (std::size_t f = 0; f < shapes.size(); ++f) fm.push_back(factor_matrices(*basis_->factors()[f], type.order));
+      const auto idx = node_factor_indices(type, type.order, reference_nodes(type), shapes, fm);
+      int c_global = 0;
+      for (std::size_t f = 0; f < shapes.size(); ++f) {
+        for (int c = 0; c < shapes[f].dim; ++c, ++c_global) {
+          auto& g = grad_[c_global];
+          g.assign(s * n, 0.0);
+          // rounded factor tables
+          std::vector<std::vector<double>> val(shapes.size()), der(shapes.size());
+          for (std::size_t h = 0; h < shapes.size(); ++h) {
+            for (const auto& q : fm[h].value) val[h].push_back(nearest_double(q));
+            for (const auto& q : fm[h].deriv[h == f ? c : 0]) der[h].push_back(nearest_double(q));
           }
+          for (std::size_t k = 0; k < s; ++k)
+            for (std::size_t i = 0; i < n; ++i) {
+              double v = shapes[f].interval ? 0.5 : 1.0;
+              for (std::size_t h = 0; h < shapes.size(); ++h) {
+                const auto kh = static_cast<std::size_t>(basis_->factor_index(static_cast<int>(k), static_cast<int>(h)));
+                const auto ih = static_cast<std::size_t>(idx[i][h]);
+                const auto nh = static_cast<std::size_t>(fm[h].num_nodes);
+                v *= (h == f) ? der[h][kh * nh + ih] : val[h][kh * nh + ih];
+              }
+              g[k * n + i] = v;
+            }
+        }
       }
+      gradient_rel_error_ = 5 * kUnit;  // 2.5u, doubled as a margin (nearest_double is within u)
+    } else {
+      build_exact();
+      for (int c = 0; c < dim_; ++c) {
+        grad_[c].resize(s * n);
+        for (std::size_t i = 0; i < s * n; ++i) grad_[c][i] = nearest_double(exact_[c][i]);
+      }
+      gradient_rel_error_ = 2 * kUnit;
     }
-    gradient_rel_error_ = 5 * kUnit;  // 2.5u, doubled as a margin (nearest_double is within u)
-  } else {
-    build_exact();
-    for (int c = 0; c < dim_; ++c) {
-      grad_[c].resize(s * n);
-      for (std::size_t i = 0; i < s * n; ++i) grad_[c][i] = nearest_double(exact_[c][i]);
-    }
-    gradient_rel_error_ = 2 * kUnit;
-  }
-  for (int c = 0; c < dim_; ++c)
-    for (std::size_t k = 0; k < s; ++k) {
-      double r = 0;
-      for (std::size_t i = 0; i < n; ++i) r += std::abs(grad_[c][k * n + i]);
-      row_sum = std::max(row_sum, r);
-    }
-  // Covers the exact entries (|exact| <= |rounded| (1 + 2 eps)) and the sum's rounding.
-  gradient_row_sum_ = row_sum * (1 + 4 * gradient_rel_error_ + rounding_gamma(static_cast<int>(n)));
+    for (int c = 0; c < dim_; ++c)
+      for (std::size_t k = 0; k < s; ++k) {
+        double r = 0;
+        for (std::size_t i = 0; i < n; ++i) r += std::abs(grad_[c][k * n + i]);
+        row_sum = std::max(row_sum, r);
+      }
+    // Covers the exact entries (|exact| <= |rounded| (1 + 2 eps)) and the sum's rounding.
+    gradient_row_sum_ = row_sum * (1 + 4 * gradient_rel_error_ + rounding_gamma(static_cast<int>(n)));
+  });
+}
+
+const std::vector<double>& JacobianSpace::gradient(int c) const {
+  build_gradients();
+  return grad_[c];
+}
+
+double JacobianSpace::gradient_row_sum() const {
+  build_gradients();
+  return gradient_row_sum_;
+}
+
+double JacobianSpace::gradient_rel_error() const {
+  build_gradients();
+  return gradient_rel_error_;
 }
 
 void JacobianSpace::build_straight() const {

@@ -33,16 +33,19 @@ class JacobianSpace {
   int num_vertices() const noexcept { return num_vertices_; }
 
   /// dN_i/dxi_c at sample k: gradient(c)[k * num_nodes + i], each entry within
-  /// gradient_rel_error() * |exact| of the exact rational. c < dim().
-  const std::vector<double>& gradient(int c) const noexcept { return grad_[c]; }
+  /// gradient_rel_error() * |exact| of the exact rational. c < dim(). Built on first use
+  /// of gradient, gradient_row_sum or gradient_rel_error (thread-safe): `check` takes the
+  /// product path and never needs them, so a type's set-up does not pay for them.
+  /// @pre has_sample_gradients()
+  const std::vector<double>& gradient(int c) const;
   /// Same for the straight-sided (first-order) element through the vertices:
   /// straight_gradient(c)[k * num_vertices + v], rounded from the exact rationals. Built
   /// on first use of any straight_* accessor (thread-safe): only distortion needs it.
   const std::vector<double>& straight_gradient(int c) const;
   /// max over samples k and directions c of sum_i |gradient(c)[k, i]| (rounded up, and
   /// covering the exact entries too).
-  double gradient_row_sum() const noexcept { return gradient_row_sum_; }
-  double gradient_rel_error() const noexcept { return gradient_rel_error_; }
+  double gradient_row_sum() const;
+  double gradient_rel_error() const;
   /// The same two constants for straight_gradient.
   double straight_row_sum() const;
   double straight_rel_error() const;
@@ -54,14 +57,16 @@ class JacobianSpace {
   /// The Bernstein-product path to J's coefficients (jacobian_product.hpp); nullptr for
   /// pyramids, which are sampled (Paper IV).
   const JacobianProduct* product() const noexcept { return product_.get(); }
-  /// Whether the sampling matrices above exist: pyramids, and the orders the sampled path
-  /// served before the product path (sampled_max_order), which `check` still samples.
-  /// Beyond them (e.g. hexahedra of order 4-6, 1331-4913 samples) only the product path is
-  /// built; jacobian_samples then evaluates the product coefficients at the points.
-  bool has_sample_gradients() const noexcept { return !grad_[0].empty(); }
+  /// Whether the sampling matrices above are available (built on first use): the orders
+  /// the sampled path served before the product path (sampled_max_order), which
+  /// jacobian_samples and the exact sampled checks still use. Beyond them (e.g. hexahedra of
+  /// order 4-6, 1331-4913 samples), and for pyramids, only the product path exists;
+  /// jacobian_samples then evaluates the product coefficients at the points.
+  bool has_sample_gradients() const noexcept { return sampled_; }
 
  private:
   void build_exact() const;
+  void build_gradients() const;
   void build_straight() const;
   void init_pyramid();  // src/analysis/pyramid_space.cpp (Paper IV)
 
@@ -71,11 +76,13 @@ class JacobianSpace {
   int num_samples_ = 0;
   int dim_ = 0;
   int num_vertices_ = 0;
-  std::vector<double> grad_[3];
+  bool sampled_ = false;  // sample gradients exist (built lazily by build_gradients)
+  mutable std::once_flag gradients_once_;
+  mutable std::vector<double> grad_[3];
   mutable std::once_flag straight_once_;
   mutable std::vector<double> straight_[3];
-  double gradient_row_sum_ = 0;
-  double gradient_rel_error_ = 0;
+  mutable double gradient_row_sum_ = 0;
+  mutable double gradient_rel_error_ = 0;
   mutable double straight_row_sum_ = 0;
   mutable double straight_rel_error_ = 0;
   std::unique_ptr<const JacobianProduct> product_;

@@ -4,7 +4,9 @@
 #include "analysis/linear_jacobian.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 
@@ -24,8 +26,14 @@ constexpr int kLanes = 8;
 using Lanes = double __attribute__((vector_size(kLanes * sizeof(double))));
 static_assert(kLinearChunk % kLanes == 0);
 
+using Bits = std::int64_t __attribute__((vector_size(kLanes * sizeof(std::int64_t))));
+static_assert(sizeof(Bits) == sizeof(Lanes));
+
 inline double vabs(double a) { return std::abs(a); }
-inline Lanes vabs(Lanes a) { return a < 0 ? -a : a; }
+// |a| lane by lane as std::abs: the sign bit cleared (one AND, no compare and blend)
+inline Lanes vabs(Lanes a) {
+  return std::bit_cast<Lanes>(std::bit_cast<Bits>(a) & std::numeric_limits<std::int64_t>::max());
+}
 inline double vmin(double a, double b) { return b < a ? b : a; }
 inline Lanes vmin(Lanes a, Lanes b) { return b < a ? b : a; }
 inline double vmax(double a, double b) { return a < b ? b : a; }
@@ -136,6 +144,33 @@ inline T quad_coefficients(Point p, T* c) {
   return error_of(lu, lv, lv * 0 + 1, 0.25);
 }
 
+// Pyramid: c[a + 2b] = J along the lateral edge through base vertex (a, b), J being
+// bilinear in (u, v) and constant in t (linear_jacobian.hpp).
+template <class T, class Point>
+inline T pyramid_coefficients(Point p, T* c) {
+  constexpr int kBaseVertex[2][2] = {{0, 3}, {1, 2}};  // [a][b], as the quadrangle's
+  const Vec3<T> apex = p(4);
+  Vec3<T> eu[2], ev[2];  // eu[b], ev[a]
+  T lu{}, lv{}, lw{};
+  #pragma GCC unroll 2
+  for (int s = 0; s < 2; ++s) {
+    eu[s] = sub(p(kBaseVertex[1][s]), p(kBaseVertex[0][s]));
+    ev[s] = sub(p(kBaseVertex[s][1]), p(kBaseVertex[s][0]));
+    lu = vmax(lu, norm1(eu[s]));
+    lv = vmax(lv, norm1(ev[s]));
+  }
+  #pragma GCC unroll 2
+  for (int a = 0; a < 2; ++a)
+    #pragma GCC unroll 2
+    for (int b = 0; b < 2; ++b) {
+      const Vec3<T> w = sub(apex, p(kBaseVertex[a][b]));
+      lw = vmax(lw, norm1(w));
+      // the 1/4 of d(xi, eta, zeta) / d(u, v, t) = -4 t^2 (its sign is in w = A - B); exact
+      c[a + 2 * b] = dot(eu[b], cross(ev[a], w)) * 0.25;
+    }
+  return error_of(lu, lv, lw, 0.25);
+}
+
 template <class T, class Point>
 inline T tet_coefficients(Point p, T* c) {
   const Vec3<T> a = sub(p(1), p(0)), b = sub(p(2), p(0)), d = sub(p(3), p(0));
@@ -159,30 +194,50 @@ inline T coefficients_of(LinearKind kind, Point p, T* c) {
     case LinearKind::quadrangle: return quad_coefficients(p, c);
     case LinearKind::tetrahedron: return tet_coefficients(p, c);
     case LinearKind::triangle: return triangle_coefficients(p, c);
+    case LinearKind::pyramid: return pyramid_coefficients(p, c);
     case LinearKind::none: break;
   }
   return c[0] * 0 + kInf;
 }
 
 constexpr int num_coefficients(LinearKind kind) {
-  return kind == LinearKind::hexahedron ? 27 : kind == LinearKind::quadrangle ? 4 : 1;
+  switch (kind) {
+    case LinearKind::hexahedron: return 27;
+    case LinearKind::pyramid:
+    case LinearKind::quadrangle: return 4;
+    default: return 1;
+  }
 }
 
-// Indices of the vertex coefficients (values of J).
+// Indices of the vertex coefficients (values of J; the pyramid's along its lateral edges).
 constexpr bool is_vertex_coefficient(LinearKind kind, int n) {
   if (kind != LinearKind::hexahedron) return true;
   return n % 3 != 1 && (n / 3) % 3 != 1 && n / 9 != 1;
 }
 
-// Per-element summary of the coefficients, filled by the vectorised pass.
-struct Summary {
-  double min_all[kLinearChunk], max_all[kLinearChunk];
-  double min_vertex[kLinearChunk], max_vertex[kLinearChunk];
-  double sum[kLinearChunk], err[kLinearChunk];
-};
+// One-ulp steps, lane by lane, for the arguments the decision below can meet: the bits
+// of next_up / next_down (outward_rounding.hpp) for every finite x, without branches. A
+// finite nonzero x steps its bit pattern by one away from zero (up) or toward zero (down)
+// as its sign says; +-0 goes to +-denorm_min. (Non-finite x: garbage, never written.)
+inline Bits away_from_zero(Lanes x) { return (std::bit_cast<Bits>(x) >> 63) | 1; }  // +1 / -1 by sign
+inline Lanes next_up_nonzero(Lanes x) {
+  return std::bit_cast<Lanes>(std::bit_cast<Bits>(x) + away_from_zero(x));
+}
+inline Lanes next_down_nonzero(Lanes x) {
+  return std::bit_cast<Lanes>(std::bit_cast<Bits>(x) - away_from_zero(x));
+}
+inline Lanes next_up_finite(Lanes x) {
+  return x == 0 ? Lanes{} + std::numeric_limits<double>::denorm_min() : next_up_nonzero(x);
+}
+inline Lanes next_down_finite(Lanes x) {
+  return x == 0 ? Lanes{} - std::numeric_limits<double>::denorm_min() : next_down_nonzero(x);
+}
 
+// The whole decision, kLanes elements at a time: coefficients, their min / max / sum, the
+// outward-rounded bounds and the verdict all in vector registers (the same IEEE operations
+// in the same order as one element at a time); only the final stores are per element.
 template <LinearKind kKind>
-void summarise(const double* soa, std::size_t count, Summary& s) {
+void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, bool* decided) {
   constexpr int n = num_coefficients(kKind);
   for (std::size_t e = 0; e < count; e += kLanes) {
     const auto point = [&](int v) {
@@ -194,10 +249,14 @@ void summarise(const double* soa, std::size_t count, Summary& s) {
       return r;
     };
     Lanes c[n];
-    const Lanes err = coefficients_of(kKind, point, c);
-    Lanes lo = c[0], hi = c[0], vlo = c[0], vhi = c[0], sum = c[0] * 0;
+    // err (before rounding up) is a positive normal number (every L in [2^-200, 2^200]) or
+    // +inf, never 0: next_up is bits + 1, and +inf becomes a NaN, which decides nothing.
+    const Lanes err = next_up_nonzero(coefficients_of(kKind, point, c));
+    // (sum from c[0], not 0 + c[0]: the same bits for every finite c[0], -0 included,
+    // and a non-finite c[0] leaves the element undecided either way)
+    Lanes lo = c[0], hi = c[0], vlo = c[0], vhi = c[0], sum = c[0];
 #pragma GCC unroll 27
-    for (int k = 0; k < n; ++k) {
+    for (int k = 1; k < n; ++k) {
       lo = vmin(lo, c[k]);
       hi = vmax(hi, c[k]);
       sum += c[k];
@@ -206,12 +265,44 @@ void summarise(const double* soa, std::size_t count, Summary& s) {
         vhi = vmax(vhi, c[k]);
       }
     }
-    std::memcpy(s.min_all + e, &lo, sizeof(Lanes));
-    std::memcpy(s.max_all + e, &hi, sizeof(Lanes));
-    std::memcpy(s.min_vertex + e, &vlo, sizeof(Lanes));
-    std::memcpy(s.max_vertex + e, &vhi, sizeof(Lanes));
-    std::memcpy(s.sum + e, &sum, sizeof(Lanes));
-    std::memcpy(s.err + e, &err, sizeof(Lanes));
+    // valid: every coefficient proven > 0, next_down(lo - err) > 0, i.e. lo - err >
+    // denorm_min; invalid: a vertex value proven <= 0, next_up(vlo + err) <= 0, i.e.
+    // vlo + err < 0 (both exact equivalences for every double, NaN and +-inf included). A
+    // NaN coefficient (only from non-finite input) may be skipped by min/max, but not by
+    // the sum (|NaN| <= max is false, as is |inf| <= max); a NaN err decides nothing.
+    // So a decided element has finite coefficients and err, and lo - err > 0 (valid) or
+    // vlo + err < 0, hence lo - err < 0 (invalid): the min J bounds are rounded from
+    // nonzero finite values, the max J bounds from finite ones.
+    const Bits finite = vabs(sum) <= std::numeric_limits<double>::max();
+    const Lanes lower = lo - err, vertex_upper = vlo + err;
+    const Bits valid = finite & (lower > std::numeric_limits<double>::denorm_min());
+    const Bits invalid = finite & (vertex_upper < 0);
+    // for n a power of two, sum * (1 / n) is sum / n exactly (both the rounded sum / n)
+    constexpr bool kPow2 = (n & (n - 1)) == 0;
+    const Lanes javg = kPow2 ? sum * (1.0 / n) : sum / static_cast<double>(n);
+    const Lanes bounds[5] = {next_down_nonzero(lower), next_up_nonzero(vertex_upper),
+                             next_down_finite(vhi - err), next_up_finite(hi + err), javg};
+    alignas(sizeof(Lanes)) double bound[5][kLanes];
+    alignas(sizeof(Bits)) std::int64_t verdict[2][kLanes];
+    std::memcpy(bound, bounds, sizeof bound);
+    std::memcpy(verdict[0], &valid, sizeof(Bits));
+    std::memcpy(verdict[1], &invalid, sizeof(Bits));
+    const std::size_t lanes = std::min<std::size_t>(kLanes, count - e);
+    for (std::size_t i = 0; i < lanes; ++i) {
+      const bool is_valid = verdict[0][i] != 0;
+      decided[e + i] = is_valid || verdict[1][i] != 0;
+      if (!decided[e + i]) continue;
+      JacobianBounds b;
+      b.jmin_lower = bound[0][i];
+      b.jmin_upper = bound[1][i];
+      b.jmax_lower = bound[2][i];
+      b.jmax_upper = bound[3][i];
+      b.javg = bound[4][i];
+      b.validity = is_valid ? Validity::valid : Validity::invalid;
+      b.stage = is_valid ? 1 : 0;
+      b.subdivisions = 0;
+      out[e + i] = b;
+    }
   }
 }
 
@@ -224,6 +315,7 @@ LinearKind linear_kind(const ElementType& type, bool planar) noexcept {
     case ElementFamily::quadrangle: return planar ? LinearKind::quadrangle : LinearKind::none;
     case ElementFamily::tetrahedron: return LinearKind::tetrahedron;
     case ElementFamily::hexahedron: return LinearKind::hexahedron;
+    case ElementFamily::pyramid: return LinearKind::pyramid;
     default: return LinearKind::none;
   }
 }
@@ -234,6 +326,7 @@ int linear_num_vertices(LinearKind kind) noexcept {
     case LinearKind::quadrangle: return 4;
     case LinearKind::tetrahedron: return 4;
     case LinearKind::hexahedron: return 8;
+    case LinearKind::pyramid: return 5;
     case LinearKind::none: break;
   }
   return 0;
@@ -250,38 +343,15 @@ double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double
 
 void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,
                            JacobianBounds* out, bool* decided) noexcept {
-  Summary s;
   switch (kind) {
-    case LinearKind::hexahedron: summarise<LinearKind::hexahedron>(soa, count, s); break;
-    case LinearKind::quadrangle: summarise<LinearKind::quadrangle>(soa, count, s); break;
-    case LinearKind::tetrahedron: summarise<LinearKind::tetrahedron>(soa, count, s); break;
-    case LinearKind::triangle: summarise<LinearKind::triangle>(soa, count, s); break;
-    case LinearKind::none: std::fill(decided, decided + count, false); return;
+    case LinearKind::hexahedron: return decide_chunk<LinearKind::hexahedron>(soa, count, out, decided);
+    case LinearKind::quadrangle: return decide_chunk<LinearKind::quadrangle>(soa, count, out, decided);
+    case LinearKind::tetrahedron: return decide_chunk<LinearKind::tetrahedron>(soa, count, out, decided);
+    case LinearKind::triangle: return decide_chunk<LinearKind::triangle>(soa, count, out, decided);
+    case LinearKind::pyramid: return decide_chunk<LinearKind::pyramid>(soa, count, out, decided);
+    case LinearKind::none: break;
   }
-  const double n = num_coefficients(kind);
-  for (std::size_t e = 0; e < count; ++e) {
-    const double err = next_up(s.err[e]);
-    const double lower = next_down(s.min_all[e] - err);
-    const double vertex_upper = next_up(s.min_vertex[e] + err);
-    // valid: every coefficient proven > 0; invalid: a vertex value proven <= 0. The +inf
-    // error of the unguarded range satisfies neither; a NaN coefficient (only from
-    // non-finite input) may be skipped by min/max, but not by the sum.
-    const bool finite = std::isfinite(s.sum[e]);
-    const bool valid = finite && lower > 0;
-    const bool invalid = finite && vertex_upper <= 0;
-    decided[e] = valid || invalid;
-    if (!decided[e]) continue;
-    JacobianBounds& b = out[e];
-    b = JacobianBounds{};
-    b.jmin_lower = lower;
-    b.jmin_upper = vertex_upper;
-    b.jmax_lower = next_down(s.max_vertex[e] - err);
-    b.jmax_upper = next_up(s.max_all[e] + err);
-    b.javg = s.sum[e] / n;
-    b.validity = valid ? Validity::valid : Validity::invalid;
-    b.stage = valid ? 1 : 0;
-    b.subdivisions = 0;
-  }
+  std::fill(decided, decided + count, false);
 }
 
 }  // namespace quadval

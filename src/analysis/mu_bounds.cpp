@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/mu_constant.hpp"
+#include "analysis/mu_control_bound.hpp"
 #include "analysis/mu_metric.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
@@ -27,6 +28,8 @@ struct Subdomain {
     return lower != o.lower ? lower > o.lower : slot > o.slot;
   }
 };
+
+thread_local int control_mode = 2;
 
 struct MuScratch {
   MuMetric metric;
@@ -93,6 +96,8 @@ bool handled_family(ElementFamily f) {
 
 }  // namespace
 
+void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
+
 bool mu_supported(const ElementType& type) noexcept {
   return handled_family(type.family) && type.has_lagrange_basis && type.order >= 1 &&
          type.order <= mu_max_order(type.family) && jacobian_bounds_supported(type);
@@ -105,20 +110,29 @@ QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
             nodes.size() << " coordinates for " << type.name);
   QV_ASSERT(options.abs_tol > 0, "abs_tol " << options.abs_tol);
   thread_local BoundsWorkspace workspace;
-  thread_local MuScratch scratch;
-
   BoundsOptions validity;
   validity.goal = BoundsGoal::validity;
-  const JacobianBounds jb = jacobian_bounds(type, nodes, validity, workspace, planar);
+  return mu_bounds_given(type, nodes, options, planar,
+                         jacobian_bounds(type, nodes, validity, workspace, planar).validity);
+}
+
+QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> nodes,
+                              const QualityOptions& options, bool /*planar: settled by validity*/,
+                              Validity validity) {
+  QV_ASSERT(mu_supported(type), "mu bounds do not handle " << type.name);
+  QV_ASSERT(nodes.size() == static_cast<std::size_t>(3 * type.num_nodes),
+            nodes.size() << " coordinates for " << type.name);
+  QV_ASSERT(options.abs_tol > 0, "abs_tol " << options.abs_tol);
+  thread_local MuScratch scratch;
   QualityBounds out;
-  if (jb.validity == Validity::invalid) {
+  if (validity == Validity::invalid) {
     out.tolerance_met = true;  // mu = 0 exactly
     return out;
   }
   if (type.family == ElementFamily::line) {
     // One singular value: mu_pw = 1 wherever J > 0.
     out.upper = 1;
-    out.lower = jb.validity == Validity::valid ? 1.0 : 0.0;
+    out.lower = validity == Validity::valid ? 1.0 : 0.0;
     out.tolerance_met = out.upper - out.lower <= options.abs_tol;
     return out;
   }
@@ -132,7 +146,7 @@ QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
   pool.resize(block);
   const double err0 = element_w(space, nodes, pool.data());
   double r_upper = corner_ratio_upper(space, pool.data(), err0);
-  if (jb.validity != Validity::valid) {
+  if (validity != Validity::valid) {
     out.upper = sqrt_up(r_upper);
     out.tolerance_met = out.upper <= options.abs_tol;
     return out;
@@ -164,11 +178,24 @@ QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
     const double m = std::sqrt(std::max(r_upper, 0.0)) - 0.9 * options.abs_tol;
     return m <= 0 ? 0.0 : m * m;
   };
+  // Per subdomain: the control-matrix bound (mu_control_bound.hpp), which converges like
+  // the certificate (quadratically) at a small fraction of its cost (mu_bench: BM_MuMode);
+  // the degree-12n certificate only for elements that kCertificateAfter splits have not
+  // settled (near-degenerate ones, where the enclosures of the control matrices lose
+  // relative accuracy), and only where the control bound falls short.
+  constexpr int kCertificateAfter = 24;
+  const auto subdomain_lower = [&](const double* w, double err, double r_lo, double r_hi) {
+    double lo = r_lo;
+    if (control_mode != 0) {
+      lo = std::max(lo, scratch.metric.control_lower_bound(space, w, err));
+      if (control_mode == 1 || out.subdivisions < kCertificateAfter || lo >= r_target() ||
+          !(std::min(r_hi, 1.0) - lo > tol_r()))
+        return lo;
+    }
+    return scratch.metric.lower_bound(space, w, err, lo, r_hi, r_target(), tol_r());
+  };
   std::priority_queue<Subdomain, std::vector<Subdomain>, std::greater<>> heap;
-  {
-    const double lo = scratch.metric.lower_bound(space, pool.data(), err0, 0, r_upper, r_target(), tol_r());
-    heap.push({lo, err0, 0});
-  }
+  heap.push({subdomain_lower(pool.data(), err0, 0, r_upper), err0, 0});
   int next_slot = 1;
   const double sub_rounding = basis.subdivision_rounding();
   scratch.sub_scratch.resize(2 * static_cast<std::size_t>(basis.size()));
@@ -206,8 +233,7 @@ QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
                         pool.data() + child + static_cast<std::size_t>(v) * ws, scratch.sub_scratch.data());
       const double corner = corner_ratio_upper(space, pool.data() + child, child_err);
       r_upper = std::min(r_upper, corner);
-      const double lo = scratch.metric.lower_bound(space, pool.data() + child, child_err, top.lower,
-                                                   std::min(corner, r_upper), r_target(), tol_r());
+      const double lo = subdomain_lower(pool.data() + child, child_err, top.lower, std::min(corner, r_upper));
       heap.push({lo, child_err, slot});
     }
     free_slots.push_back(top.slot);

@@ -16,6 +16,7 @@
 #include <limits>
 #include <tuple>
 
+#include "analysis/mu_control_bound.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "quadval/error.hpp"
 
@@ -78,8 +79,7 @@ void MuMetric::product(const BernsteinProduct& table,
   out.mag = max_abs(out.c);
 }
 
-double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
-                             double r_hi, double r_target, double tol_r) {
+void MuMetric::metric_entries(const MuSpace& space, const double* w, double err) {
   const int dim = space.dim();
   const auto ws = static_cast<std::size_t>(space.w_size());
   for (int j = 0; j < dim * 3; ++j) {
@@ -89,12 +89,41 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
     p.mag = max_abs(p.c);
   }
   const BernsteinProduct& p11 = space.prod(1, 1);
-  const BernsteinProduct& p22 = space.prod(2, 2);
   const auto dot = [&](int a, int b, Poly& out) {
     product(p11, {{1.0, &w_[3 * a], &w_[3 * b]}, {1.0, &w_[3 * a + 1], &w_[3 * b + 1]},
                   {1.0, &w_[3 * a + 2], &w_[3 * b + 2]}},
             out);
   };
+  // m_: m00, m11, m22, m01, m02, m12 (2D: m00, m11, -, m01).
+  dot(0, 0, m_[0]);
+  dot(1, 1, m_[1]);
+  dot(0, 1, m_[3]);
+  if (dim == 3) {
+    dot(2, 2, m_[2]);
+    dot(0, 2, m_[4]);
+    dot(1, 2, m_[5]);
+  }
+}
+
+double MuMetric::control_lower_bound(const MuSpace& space, const double* w, double err) {
+  metric_entries(space, w, err);
+  const int size = static_cast<int>(m_[0].c.size());
+  if (space.dim() == 2) {
+    const double* e[3] = {m_[0].c.data(), m_[1].c.data(), m_[3].c.data()};
+    const double er[3] = {m_[0].err, m_[1].err, m_[3].err};
+    return control_ratio_lower<2>(e, er, size);
+  }
+  const double* e[6];
+  double er[6];
+  for (int i = 0; i < 6; ++i) e[i] = m_[i].c.data(), er[i] = m_[i].err;
+  return control_ratio_lower<3>(e, er, size);
+}
+
+double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
+                             double r_hi, double r_target, double tol_r) {
+  const int dim = space.dim();
+  metric_entries(space, w, err);
+  const BernsteinProduct& p22 = space.prod(2, 2);
   // out = sum a_i f_i coefficient-wise, with its error bound.
   const auto combine = [](std::initializer_list<std::pair<double, const Poly*>> terms, Poly& out) {
     const std::size_t n = terms.begin()->second->c.size();
@@ -112,9 +141,6 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
   };
 
   if (dim == 2) {
-    dot(0, 0, m_[0]);
-    dot(1, 1, m_[1]);
-    dot(0, 1, m_[3]);
     combine({{0.5, &m_[0]}, {0.5, &m_[1]}}, q_);
     combine({{0.5, &m_[0]}, {-0.5, &m_[1]}}, s_);
     product(p22, {{1.0, &q_, &q_}}, q2_);
@@ -131,13 +157,7 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
     return std::max(r_lo, std::min(r, 1.0));
   }
 
-  // 3D: metric entries, q, D = M - q I, p^2 = tr D^2 / 6, e3 = det D.
-  dot(0, 0, m_[0]);
-  dot(1, 1, m_[1]);
-  dot(2, 2, m_[2]);
-  dot(0, 1, m_[3]);
-  dot(0, 2, m_[4]);
-  dot(1, 2, m_[5]);
+  // 3D: q, D = M - q I, p^2 = tr D^2 / 6, e3 = det D.
   combine({{1.0 / 3, &m_[0]}, {1.0 / 3, &m_[1]}, {1.0 / 3, &m_[2]}}, q_);
   for (int i = 0; i < 3; ++i) combine({{1.0, &m_[i]}, {-1.0, &q_}}, d_[i]);
   product(p22, {{1.0 / 6, &d_[0], &d_[0]}, {1.0 / 6, &d_[1], &d_[1]}, {1.0 / 6, &d_[2], &d_[2]},
@@ -408,8 +428,12 @@ namespace {
 template <int D>
 double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err) {
   const Eigen::Matrix<double, D, D> m = wm.transpose() * wm;
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig(m);
-  if (eig.info() != Eigen::Success) return 1;
+  if (!m.allFinite()) return 1;
+  // Closed-form eigenvectors: any v gives a valid Rayleigh bound, accuracy only matters
+  // for tightness (the quotient's error is quadratic in v's).
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig;
+  eig.computeDirect(m);
+  if (!eig.eigenvectors().allFinite()) return 1;
   // Rayleigh quotient |W v|^2 / |v|^2, enclosed: y_c = sum_j w_cj v_j within
   // err sum|v| + gamma_4 sum |w_cj v_j| (+1e-12 relative for the bound's own rounding).
   const auto rayleigh = [&](const Eigen::Matrix<double, D, 1>& v, bool upper) {

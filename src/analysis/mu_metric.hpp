@@ -57,6 +57,11 @@ class MuMetric {
   double lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
                      double r_hi, double r_target, double tol_r);
 
+  /// Certified lower bound of min R over the subdomain from the control matrices of
+  /// M = W^T W alone (degree 2n; mu_control_bound.hpp): one product and one small
+  /// eigenvalue enclosure per control matrix. Same parameters as lower_bound.
+  double control_lower_bound(const MuSpace& space, const double* w, double err);
+
  private:
   struct Poly {
     std::vector<double> c;
@@ -65,6 +70,7 @@ class MuMetric {
   };
   void product(const BernsteinProduct& table,
                std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms, Poly& out);
+  void metric_entries(const MuSpace& space, const double* w, double err);
   bool certify_3d(double r);
   bool certify_direct(const BernsteinProduct& p66, double r);
   // Degree-6n sufficient test A - sqrt(27) r (r+1) P^3 >= 0, P >= p (make_p_upper).

@@ -11,6 +11,8 @@
 #include "bezier/bernstein_product.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
+#include "quadval/jacobian_bounds.hpp"
+#include "quadval/quality_bounds.hpp"
 
 namespace quadval {
 
@@ -68,5 +70,11 @@ class MuSpace {
 
 /// The shared space of `type`; thread-safe, built once.
 const MuSpace& mu_space(const ElementType& type);
+
+/// mu_bounds (quadval/mu_bounds.hpp) with the element's validity already settled by the
+/// Jacobian engine (validity goal or finer), as check_mesh has it: the same bounds
+/// without computing it again. @pre validity is the certified answer for these nodes
+QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> nodes,
+                              const QualityOptions& options, bool planar, Validity validity);
 
 }  // namespace quadval

@@ -81,6 +81,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
     : f_degrees_(std::move(f)), g_degrees_(std::move(g)) {
   QV_ASSERT(!f_degrees_.empty() && f_degrees_.size() <= 3, "1 to 3 factors");
   h_degrees_ = product_degrees(f_degrees_, g_degrees_);
+  std::vector<mpq_class> exact_w[3];  // the factor weights of entries_, exactly
   int fs = 1, gs = 1, hs = 1;
   for (std::size_t fac = 0; fac < 3; ++fac) {
     f_stride_[fac] = fs;
@@ -88,6 +89,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
     h_stride_[fac] = hs;
     if (fac >= f_degrees_.size()) {
       entries_[fac] = {{0, 0, 0, 1.0}};
+      exact_w[fac] = {mpq_class(1)};
       continue;
     }
     const int d = f_degrees_[fac].dim;
@@ -106,6 +108,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
         const int kk = h_index.at(k);
         const mpq_class w(multinomial(fi[i], d) * multinomial(gi[j], d), multinomial(k, d));
         entries_[fac].push_back({static_cast<int>(i), static_cast<int>(j), kk, nearest_double(mpq_class(w))});
+        exact_w[fac].push_back(w);
         ++terms[static_cast<std::size_t>(kk)];
       }
     int most = 0;
@@ -175,6 +178,27 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
   h_grid_ = make_grid(h_degrees_, true);
   // Small products: the grids' set-up costs more than the gathers (measured, mu_bench).
   entries_kernel_ = static_cast<long>(f_size_) * g_size_ < kEntryKernelBelow;
+  if (entries_kernel_) {
+    // Flattened entry kernel: every (i, j) pair with its exact tensor weight, by k.
+    std::vector<std::vector<Pair>> rows(static_cast<std::size_t>(h_size_));
+    for (std::size_t a2 = 0; a2 < entries_[2].size(); ++a2)
+      for (std::size_t a1 = 0; a1 < entries_[1].size(); ++a1)
+        for (std::size_t a0 = 0; a0 < entries_[0].size(); ++a0) {
+          const Entry& e0 = entries_[0][a0];
+          const Entry& e1 = entries_[1][a1];
+          const Entry& e2 = entries_[2][a2];
+          const int i = e0.i * f_stride_[0] + e1.i * f_stride_[1] + e2.i * f_stride_[2];
+          const int j = e0.j * g_stride_[0] + e1.j * g_stride_[1] + e2.j * g_stride_[2];
+          const int k = e0.k * h_stride_[0] + e1.k * h_stride_[1] + e2.k * h_stride_[2];
+          const mpq_class w = exact_w[0][a0] * exact_w[1][a1] * exact_w[2][a2];
+          rows[static_cast<std::size_t>(k)].push_back({i, j, nearest_double(w)});
+        }
+    row_start_.push_back(0);
+    for (const auto& r : rows) {
+      pairs_.insert(pairs_.end(), r.begin(), r.end());
+      row_start_.push_back(static_cast<int>(pairs_.size()));
+    }
+  }
 }
 
 void BernsteinProduct::accumulate_grid(const double* f, const double* g, double scale,
@@ -228,16 +252,28 @@ void BernsteinProduct::multiply_add(const double* f, const double* g, double sca
     multiply_add_sum(std::span<const Term>(&t, 1), h);
     return;
   }
-  for (const Entry& e2 : entries_[2]) {
-    const int f2 = e2.i * f_stride_[2], g2 = e2.j * g_stride_[2], h2 = e2.k * h_stride_[2];
-    for (const Entry& e1 : entries_[1]) {
-      const double w12 = scale * (e2.w * e1.w);
-      const int f1 = f2 + e1.i * f_stride_[1], g1 = g2 + e1.j * g_stride_[1];
-      double* h1 = h + h2 + e1.k * h_stride_[1];
-      const double* fp = f + f1;
-      const double* gp = g + g1;
-      for (const Entry& e0 : entries_[0]) h1[e0.k] += (w12 * e0.w) * (fp[e0.i] * gp[e0.j]);
+  if (pairs_.empty()) {  // a large product switched to the entry loop (tests)
+    for (const Entry& e2 : entries_[2]) {
+      const int f2 = e2.i * f_stride_[2], g2 = e2.j * g_stride_[2], h2 = e2.k * h_stride_[2];
+      for (const Entry& e1 : entries_[1]) {
+        const double w12 = scale * (e2.w * e1.w);
+        const int f1 = f2 + e1.i * f_stride_[1], g1 = g2 + e1.j * g_stride_[1];
+        double* h1 = h + h2 + e1.k * h_stride_[1];
+        const double* fp = f + f1;
+        const double* gp = g + g1;
+        for (const Entry& e0 : entries_[0]) h1[e0.k] += (w12 * e0.w) * (fp[e0.i] * gp[e0.j]);
+      }
     }
+    return;
+  }
+  // Per term w (rounded once) * (f_i g_j): 2 roundings, the row's sum, times scale and
+  // added into h: within the 16 + terms roundings of rounding() (top of this file).
+  const Pair* pairs = pairs_.data();
+  for (int k = 0; k < h_size_; ++k) {
+    double acc = 0;
+    for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p)
+      acc += pairs[p].w * (f[pairs[p].i] * g[pairs[p].j]);
+    h[k] += scale * acc;
   }
 }
 

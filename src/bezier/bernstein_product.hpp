@@ -74,6 +74,15 @@ class BernsteinProduct {
   int max_terms_ = 1;
   std::array<int, 3> f_stride_{}, g_stride_{}, h_stride_{};
   std::vector<Entry> entries_[3];  // per factor; unused factors hold one entry {0,0,0,1}
+  // The entry kernel flattened over the tensor product and grouped by output coefficient
+  // (small products only): pairs_[row_start_[k] .. row_start_[k + 1]) are the (i, j) of
+  // h_k, each with its tensor weight computed exactly and rounded once.
+  struct Pair {
+    int i, j;
+    double w;
+  };
+  std::vector<int> row_start_;
+  std::vector<Pair> pairs_;
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
   // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k. Every

@@ -164,40 +164,6 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
       if (alphas_[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] == degree)
         vertex_[static_cast<std::size_t>(i)] = true;
 
-  // Collocation matrix V[k][alpha] = B_alpha(point k) (eq. 18), rounded; T = V^-1 is
-  // built on first use (build_to_bezier).
-  {
-    // Integer arithmetic: B_alpha(beta / m) = mult(alpha) prod beta_a^alpha_a / m^n, one
-    // rational (and one rounding) per nonzero entry: the same doubles as collocation().
-    const mpz_class den_power = [&] {
-      mpz_class r;
-      mpz_ui_pow_ui(r.get_mpz_t(), static_cast<unsigned long>(point_denominator()), static_cast<unsigned long>(degree));
-      return r;
-    }();
-    std::vector<mpz_class> mult(n_sz);
-    for (std::size_t i = 0; i < n_sz; ++i) mult[i] = multinomial(dim, alphas_[i]);
-    to_lagrange_.assign(n_sz * n_sz, 0.0);
-    mpz_class num, power;
-    for (std::size_t k = 0; k < n_sz; ++k) {
-      const MultiIndex beta = point_numerators(static_cast<int>(k));
-      for (std::size_t i = 0; i < n_sz; ++i) {
-        const MultiIndex& alpha = alphas_[i];
-        num = mult[i];
-        for (int a = 0; a <= dim && sgn(num) != 0; ++a) {
-          const auto e = static_cast<unsigned long>(alpha[static_cast<std::size_t>(a)]);
-          if (e == 0) continue;
-          mpz_ui_pow_ui(power.get_mpz_t(), static_cast<unsigned long>(beta[static_cast<std::size_t>(a)]), e);
-          num *= power;
-        }
-        if (sgn(num) == 0) continue;
-        mpq_class q(num, den_power);
-        q.canonicalize();
-        to_lagrange_[k * n_sz + i] = nearest_double(q);
-      }
-    }
-    to_lagrange_t_ = transpose_blocks(to_lagrange_, n_sz);
-  }
-
   // Subdivision (eq. 20) by blossoming: the child's coefficient beta is the blossom of the
   // parent at (w_0 repeated beta_0 times, ..., w_d repeated beta_d times), i.e. the
   // coefficient of t^alpha in prod_k (w_k . t)^beta_k times the parent's b_alpha.
@@ -260,6 +226,54 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
     }
   }
   subdivision_t_ = transpose_blocks(subdivision_, n_sz);
+}
+
+void BernsteinSimplex::build_to_lagrange() const {
+  std::call_once(to_lagrange_once_, [this] {
+    const int dim = dim_, degree = degree_;
+    const auto n_sz = static_cast<std::size_t>(size());
+    // Collocation matrix V[k][alpha] = B_alpha(point k) (eq. 18), rounded (T = V^-1:
+    // build_to_bezier). Integer arithmetic: B_alpha(beta / m) = mult(alpha)
+    // prod beta_a^alpha_a / m^n, one rational (and one rounding) per nonzero entry: the
+    // same doubles as collocation().
+    const mpz_class den_power = [&] {
+      mpz_class r;
+      mpz_ui_pow_ui(r.get_mpz_t(), static_cast<unsigned long>(point_denominator()), static_cast<unsigned long>(degree));
+      return r;
+    }();
+    std::vector<mpz_class> mult(n_sz);
+    for (std::size_t i = 0; i < n_sz; ++i) mult[i] = multinomial(dim, alphas_[i]);
+    to_lagrange_.assign(n_sz * n_sz, 0.0);
+    mpz_class num, power;
+    for (std::size_t k = 0; k < n_sz; ++k) {
+      const MultiIndex beta = point_numerators(static_cast<int>(k));
+      for (std::size_t i = 0; i < n_sz; ++i) {
+        const MultiIndex& alpha = alphas_[i];
+        num = mult[i];
+        for (int a = 0; a <= dim && sgn(num) != 0; ++a) {
+          const auto e = static_cast<unsigned long>(alpha[static_cast<std::size_t>(a)]);
+          if (e == 0) continue;
+          mpz_ui_pow_ui(power.get_mpz_t(), static_cast<unsigned long>(beta[static_cast<std::size_t>(a)]), e);
+          num *= power;
+        }
+        if (sgn(num) == 0) continue;
+        mpq_class q(num, den_power);
+        q.canonicalize();
+        to_lagrange_[k * n_sz + i] = nearest_double(q);
+      }
+    }
+    to_lagrange_t_ = transpose_blocks(to_lagrange_, n_sz);
+  });
+}
+
+std::span<const double> BernsteinSimplex::bezier_to_lagrange() const {
+  build_to_lagrange();
+  return to_lagrange_;
+}
+
+std::span<const double> BernsteinSimplex::bezier_to_lagrange_transposed() const {
+  build_to_lagrange();
+  return to_lagrange_t_;
 }
 
 void BernsteinSimplex::build_to_bezier() const {

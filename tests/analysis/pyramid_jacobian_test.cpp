@@ -5,12 +5,16 @@
 #include <gmpxx.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <map>
 #include <random>
 #include <sstream>
 
+#include "analysis/jacobian_engine.hpp"
+#include "analysis/jacobian_space.hpp"
 #include "bezier/pyramid_basis.hpp"
 #include "jacobian_test_util.hpp"
 #include "quadval/check_report.hpp"
@@ -373,6 +377,211 @@ TEST(PyramidJacobian, ZeroAtACornerIsInvalidByExactArithmetic) {
   EXPECT_EQ(b.validity, Validity::invalid);
   EXPECT_LE(b.jmin_lower, 0);
   EXPECT_GE(b.jmin_upper, 0);
+}
+
+// ---- The generalized basis of eq. (4) against the enriched basis of eq. (6), exactly.
+// J of an order-r pyramid, written in cube coordinates as sum_k B^n_k(t) P_k(u, v)
+// (n = 3r-3), has its generalized coefficients g_ijk = Bernstein coefficients of P_k in
+// degree k+2 and its enriched ones e_lmk = those of P_k in degree 3r-1 (the same P_k:
+// both bases share the t factor). Degree elevation makes every e a convex combination of
+// the g of its slice, with the corners equal, so min e >= min g and max e <= max g: eq. 4
+// never settles a sign the enriched coefficients leave open. Here P_k comes from the
+// exact oracle (tensor interpolation of exact J values), nothing from the Bézier code.
+struct PyramidBases {
+  int r = 0;
+  std::vector<std::vector<mpq_class>> generalized;  // [k][i + (k+3) j]
+  std::vector<mpq_class> enriched;                  // l + N (m + N k), N = 3r
+  bool in_eq4_space = true;                         // deg P_k <= k+2 in u and in v
+};
+
+mpz_class binom(int n, int k) {
+  if (k < 0 || k > n) return 0;
+  mpz_class b;
+  mpz_bin_uiui(b.get_mpz_t(), static_cast<unsigned long>(n), static_cast<unsigned long>(k));
+  return b;
+}
+
+// Inverse of the Vandermonde matrix of the points (row: monomial power, column: point).
+std::vector<mpq_class> inverse_vandermonde(const std::vector<mpq_class>& x) {
+  const std::size_t n = x.size();
+  std::vector<mpq_class> v(n * n), inv(n * n, mpq_class(0));
+  for (std::size_t i = 0; i < n; ++i) {
+    inv[i * n + i] = 1;
+    for (std::size_t p = 0; p < n; ++p) v[i * n + p] = qpow(x[i], static_cast<int>(p));
+  }
+  for (std::size_t c = 0; c < n; ++c) {  // Gauss-Jordan on rows (points)
+    const mpq_class pv = v[c * n + c];
+    for (std::size_t k = 0; k < n; ++k) v[c * n + k] /= pv, inv[c * n + k] /= pv;
+    for (std::size_t r2 = 0; r2 < n; ++r2)
+      if (r2 != c) {
+        const mpq_class f = v[r2 * n + c];
+        if (sgn(f) == 0) continue;
+        for (std::size_t k = 0; k < n; ++k) v[r2 * n + k] -= f * v[c * n + k], inv[r2 * n + k] -= f * inv[c * n + k];
+      }
+  }
+  return inv;  // monomial coefficient p = sum_i inv[p * n + i] value_i
+}
+
+// Monomial coefficients m[a] (a <= deg) to Bernstein degree p: u^a = sum_i C(i,a)/C(p,a) B^p_i.
+std::vector<mpq_class> to_bernstein(const std::vector<mpq_class>& m, int p) {
+  std::vector<mpq_class> b(static_cast<std::size_t>(p + 1), mpq_class(0));
+  for (std::size_t a = 0; a < m.size(); ++a) {
+    if (sgn(m[a]) == 0) continue;
+    const int ai = static_cast<int>(a);
+    EXPECT_LE(ai, p);
+    for (int i = ai; i <= p; ++i) b[static_cast<std::size_t>(i)] += m[a] * mpq_class(binom(i, ai), binom(p, ai));
+  }
+  for (auto& q : b) q.canonicalize();
+  return b;
+}
+
+PyramidBases pyramid_bases(const ElementType& type, const std::vector<mpq_class>& xq) {
+  PyramidBases out;
+  const int r = type.order, N = 3 * r, nt = 3 * r - 2;  // points per axis (degrees N-1, nt-1)
+  out.r = r;
+  const ExactPyramid ep = exact_pyramid(type);
+  std::vector<mpq_class> uu(static_cast<std::size_t>(N)), tt(static_cast<std::size_t>(nt));
+  for (int i = 0; i < N; ++i) uu[static_cast<std::size_t>(i)] = mpq_class(i, N - 1), uu[static_cast<std::size_t>(i)].canonicalize();
+  for (int k = 0; k < nt; ++k) tt[static_cast<std::size_t>(k)] = mpq_class(k + 1, nt), tt[static_cast<std::size_t>(k)].canonicalize();
+  const auto iu = inverse_vandermonde(uu), it = inverse_vandermonde(tt);
+  const auto idx = [N](int a, int b, int c) { return static_cast<std::size_t>(a + N * (b + N * c)); };
+  std::vector<mpq_class> val(static_cast<std::size_t>(N * N * nt));
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j)
+      for (int k = 0; k < nt; ++k) {
+        const mpq_class& t = tt[static_cast<std::size_t>(k)];
+        val[idx(i, j, k)] = exact_jacobian(ep, xq, (2 * uu[static_cast<std::size_t>(i)] - 1) * t,
+                                           (2 * uu[static_cast<std::size_t>(j)] - 1) * t, 1 - t);
+      }
+  // values -> monomials in u, then v (inverse Vandermonde), then t -> Bernstein degree nt-1
+  std::vector<mpq_class> m1(val.size()), m2(val.size());
+  for (int a = 0; a < N; ++a)
+    for (int j = 0; j < N; ++j)
+      for (int k = 0; k < nt; ++k)
+        for (int i = 0; i < N; ++i) m1[idx(a, j, k)] += iu[static_cast<std::size_t>(a * N + i)] * val[idx(i, j, k)];
+  for (int a = 0; a < N; ++a)
+    for (int b = 0; b < N; ++b)
+      for (int k = 0; k < nt; ++k)
+        for (int j = 0; j < N; ++j) m2[idx(a, b, k)] += iu[static_cast<std::size_t>(b * N + j)] * m1[idx(a, j, k)];
+  std::vector<mpq_class> pk(val.size());  // P_k: monomial (a, b), Bernstein index k in t
+  for (int a = 0; a < N; ++a)
+    for (int b = 0; b < N; ++b) {
+      std::vector<mpq_class> mono(static_cast<std::size_t>(nt), mpq_class(0));
+      for (int c = 0; c < nt; ++c)
+        for (int k = 0; k < nt; ++k) mono[static_cast<std::size_t>(c)] += it[static_cast<std::size_t>(c * nt + k)] * m2[idx(a, b, k)];
+      const auto bern = to_bernstein(mono, nt - 1);
+      for (int k = 0; k < nt; ++k) pk[idx(a, b, k)] = bern[static_cast<std::size_t>(k)];
+    }
+  out.enriched.assign(val.size(), mpq_class(0));
+  for (int k = 0; k < nt; ++k) {
+    const int p = k + 2;
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b)
+        if ((a > p || b > p) && sgn(pk[idx(a, b, k)]) != 0) out.in_eq4_space = false;
+    // Bernstein in u then v, of degree d, of the slice's monomials
+    const auto slice_bernstein = [&](int d) {
+      const auto D = static_cast<std::size_t>(d + 1);
+      std::vector<mpq_class> tmp(D * static_cast<std::size_t>(N)), res(D * D);
+      for (int b = 0; b < N; ++b) {
+        std::vector<mpq_class> mono(static_cast<std::size_t>(std::min(N, d + 1)));
+        for (std::size_t a = 0; a < mono.size(); ++a) mono[a] = pk[idx(static_cast<int>(a), b, k)];
+        const auto bu = to_bernstein(mono, d);
+        for (std::size_t i = 0; i < D; ++i) tmp[i + D * static_cast<std::size_t>(b)] = bu[i];
+      }
+      for (std::size_t i = 0; i < D; ++i) {
+        std::vector<mpq_class> mono(static_cast<std::size_t>(std::min(N, d + 1)));
+        for (std::size_t b = 0; b < mono.size(); ++b) mono[b] = tmp[i + D * b];
+        const auto bv = to_bernstein(mono, d);
+        for (std::size_t j = 0; j < D; ++j) res[i + D * j] = bv[j];
+      }
+      return res;
+    };
+    out.generalized.push_back(slice_bernstein(p));
+    const auto e = slice_bernstein(N - 1);
+    for (int i = 0; i < N; ++i)
+      for (int j = 0; j < N; ++j) out.enriched[idx(i, j, k)] = e[static_cast<std::size_t>(i + N * j)];
+  }
+  return out;
+}
+
+mpq_class bernstein(int n, int i, const mpq_class& x) {
+  return mpq_class(binom(n, i)) * qpow(x, i) * qpow(1 - x, n - i);
+}
+
+struct LevelZero {
+  int elements = 0, enriched_valid = 0, generalized_valid = 0, corner_invalid = 0;
+  int sharper_min = 0;  // elements with min e > min g
+};
+
+// One element: both expansions reproduce J exactly at random rational points; the
+// enriched coefficients lie in the convex hull of the generalized ones, corners equal.
+void compare_bases(const ElementType& type, const std::vector<double>& x, std::mt19937& rng, LevelZero& tally) {
+  const std::vector<mpq_class> xq(x.begin(), x.end());
+  const PyramidBases pb = pyramid_bases(type, xq);
+  ASSERT_TRUE(pb.in_eq4_space);  // J in the space of eq. (4): deg P_k <= k+2
+  const int N = 3 * pb.r, n = 3 * pb.r - 3;
+  const ExactPyramid ep = exact_pyramid(type);
+  std::uniform_int_distribution<int> num(1, 96);
+  for (int s = 0; s < 3; ++s) {
+    const mpq_class u(num(rng), 97), v(num(rng), 97), t(num(rng), 97);
+    const mpq_class want = exact_jacobian(ep, xq, (2 * u - 1) * t, (2 * v - 1) * t, 1 - t);
+    mpq_class g = 0, e = 0;
+    for (int k = 0; k <= n; ++k) {
+      const mpq_class bt = bernstein(n, k, t);
+      for (int i = 0; i <= k + 2; ++i)
+        for (int j = 0; j <= k + 2; ++j)
+          g += pb.generalized[static_cast<std::size_t>(k)][static_cast<std::size_t>(i + (k + 3) * j)] *
+               bernstein(k + 2, i, u) * bernstein(k + 2, j, v) * bt;
+      for (int i = 0; i < N; ++i)
+        for (int j = 0; j < N; ++j)
+          e += pb.enriched[static_cast<std::size_t>(i + N * (j + N * k))] * bernstein(N - 1, i, u) * bernstein(N - 1, j, v) * bt;
+    }
+    ASSERT_EQ(g, want);
+    ASSERT_EQ(e, want);
+  }
+  mpq_class gmin = pb.generalized[0][0], gmax = gmin, emin = pb.enriched[0], emax = emin;
+  bool corner_nonpositive = false;
+  for (int k = 0; k <= n; ++k) {
+    const auto& gk = pb.generalized[static_cast<std::size_t>(k)];
+    for (const mpq_class& c : gk) gmin = std::min(gmin, c), gmax = std::max(gmax, c);
+    for (int i : {0, 1})
+      for (int j : {0, 1}) {  // corners of the slice: the same in both bases
+        const mpq_class& gc = gk[static_cast<std::size_t>(i * (k + 2) + (k + 3) * j * (k + 2))];
+        ASSERT_EQ(gc, pb.enriched[static_cast<std::size_t>(i * (N - 1) + N * (j * (N - 1) + N * k))]);
+        if ((k == 0 || k == n) && sgn(gc) <= 0) corner_nonpositive = true;  // J at a vertex or apex limit
+      }
+  }
+  for (const mpq_class& c : pb.enriched) emin = std::min(emin, c), emax = std::max(emax, c);
+  ASSERT_GE(emin, gmin);
+  ASSERT_LE(emax, gmax);
+  ++tally.elements;
+  tally.enriched_valid += sgn(emin) > 0;
+  tally.generalized_valid += sgn(gmin) > 0;
+  tally.corner_invalid += corner_nonpositive;
+  tally.sharper_min += emin > gmin;
+}
+
+// Random order-2 pyramids (14 and 13 nodes) on the 1/64 lattice.
+TEST(PyramidJacobian, GeneralizedBasisOfEq4NeverSharperThanEnrichedAtLevelZero) {
+  std::mt19937 rng(21);
+  std::uniform_int_distribution<int> jitter(-12, 12);
+  LevelZero tally;
+  for (const ElementType* type : pyramid_types(2)) {
+    if (type->order < 2) continue;
+    SCOPED_TRACE(std::string(type->name));
+    const int count = 10;
+    for (int e = 0; e < count; ++e) {
+      std::vector<double> x;  // mild to strong curving: valid and invalid ones
+      for (const RefPoint& p : reference_nodes(*type))
+        for (int k = 0; k < 3; ++k) x.push_back(std::round(64 * p[static_cast<std::size_t>(k)]) / 64 + jitter(rng) * (e % 4) / 128.0);
+      compare_bases(*type, x, rng, tally);
+    }
+  }
+  std::cout << "level 0 on " << tally.elements << " random pyramids: min coefficient > 0 for " << tally.enriched_valid
+            << " (enriched, eq. 6) vs " << tally.generalized_valid << " (generalized, eq. 4); enriched min sharper on "
+            << tally.sharper_min << "; a corner <= 0 on " << tally.corner_invalid << "\n";
+  EXPECT_LE(tally.generalized_valid, tally.enriched_valid);
+  EXPECT_GT(tally.enriched_valid, 0);
 }
 
 using test::read_gmsh_ratios;

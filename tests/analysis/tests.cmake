@@ -4,6 +4,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/mu_filter_test.cpp
   analysis/mu_bernstein_product_test.cpp
   analysis/mu_constant_test.cpp
+  analysis/mu_control_bound_test.cpp
   analysis/jacobian_bounds_test.cpp
   analysis/jacobian_exact_test.cpp
   analysis/gmsh_agreement_test.cpp
@@ -14,4 +15,6 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/linear_fast_path_test.cpp
   analysis/jacobian_batch_test.cpp
   analysis/check_threads_test.cpp
+  analysis/check_stream_test.cpp
+  analysis/product_tables_test.cpp
 )

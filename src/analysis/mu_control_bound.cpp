@@ -1,0 +1,199 @@
+// Bounds of R from the control matrices of M (see mu_control_bound.hpp for the method).
+// Rounding: each short sum of products below (at most a dozen operations) is within
+// gamma_16 of the exact value relative to the sum of the absolute values of its terms
+// (Higham §3.1); error radii are enlarged by (1 + gamma_16) for their own rounding, and
+// every final bound is stepped one ulp outward.
+#include "analysis/mu_control_bound.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "analysis/outward_rounding.hpp"
+#include "quadval/bezier_basis.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+const double kGamma = rounding_gamma(16);
+
+EigenEnclosure unknown() { return {-kInf, kInf, -kInf, kInf}; }
+
+// theta in [1 - eps, 1 + eps]: the range of x / theta, rounded outward.
+double divide_down(double x, double eps) {
+  return next_down(x / next_down(x >= 0 ? 1 + eps : 1 - eps));
+}
+double divide_up(double x, double eps) {
+  return next_up(x / next_up(x >= 0 ? 1 - eps : 1 + eps));
+}
+
+}  // namespace
+
+double EigenEnclosure::ratio_lower() const noexcept {
+  if (!(min_lo > 0) || !(max_hi < kInf)) return 0;
+  return std::clamp(next_down(min_lo / max_hi), 0.0, 1.0);
+}
+
+double EigenEnclosure::ratio_upper() const noexcept {
+  if (!(max_lo > 0) || !(min_hi < kInf)) return 1;
+  return std::clamp(next_up(min_hi / max_lo), 0.0, 1.0);
+}
+
+template <>
+EigenEnclosure symmetric_eigen_enclosure<2>(const double* m, double err) {
+  // lambda = q +- d, q = (m00 + m11) / 2, d = sqrt(s^2 + t^2), s = (m00 - m11) / 2, t = m01.
+  const double q = 0.5 * (m[0] + m[1]);
+  const double s = 0.5 * (m[0] - m[1]);
+  const double t = m[2];
+  const double rq = (err + kGamma * 0.5 * (std::abs(m[0]) + std::abs(m[1]))) * (1 + kGamma);
+  const double rt = err;
+  const double s_hi = next_up(std::abs(s) + rq), s_lo = std::max(0.0, next_down(std::abs(s) - rq));
+  const double t_hi = next_up(std::abs(t) + rt), t_lo = std::max(0.0, next_down(std::abs(t) - rt));
+  const double d_hi = next_up(std::sqrt(next_up(next_up(s_hi * s_hi) + next_up(t_hi * t_hi))));
+  const double d_lo = std::max(0.0, next_down(std::sqrt(std::max(0.0, next_down(next_down(s_lo * s_lo) + next_down(t_lo * t_lo))))));
+  const double q_lo = next_down(q - rq), q_hi = next_up(q + rq);
+  if (!std::isfinite(q_lo) || !std::isfinite(q_hi) || !std::isfinite(d_hi)) return unknown();
+  return {next_down(q_lo - d_hi), next_up(q_hi - d_lo), next_down(q_lo + d_lo), next_up(q_hi + d_hi)};
+}
+
+template <>
+EigenEnclosure symmetric_eigen_enclosure<3>(const double* m, double err) {
+  Eigen::Matrix3d a;
+  a << m[0], m[3], m[4], m[3], m[1], m[5], m[4], m[5], m[2];
+  if (!a.allFinite()) return unknown();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(a);  // closed form: any V is sound, only the tightness depends on it
+  const Eigen::Matrix3d& v = eig.eigenvectors();
+  if (!v.allFinite()) return unknown();
+  // eps >= |V^T V - I|_2 (max row sum of the symmetric error matrix, rounding included).
+  double eps = 0;
+  for (int i = 0; i < 3; ++i) {
+    double row = 0;
+    for (int j = 0; j < 3; ++j) {
+      const double s = v(0, i) * v(0, j) + v(1, i) * v(1, j) + v(2, i) * v(2, j);
+      const double mag = std::abs(v(0, i) * v(0, j)) + std::abs(v(1, i) * v(1, j)) + std::abs(v(2, i) * v(2, j));
+      row += std::abs(i == j ? s - 1 : s) + kGamma * (mag + 1);
+    }
+    eps = std::max(eps, row * (1 + kGamma));
+  }
+  if (!(eps < 0.5)) return unknown();
+  // B = V^T a V computed; |B - V^T M V| <= err s_i s_j + gamma (|V|^T |a| |V|)_ij.
+  const Eigen::Matrix3d t = a * v;
+  const Eigen::Matrix3d b = v.transpose() * t;
+  const Eigen::Matrix3d av = v.cwiseAbs();
+  const Eigen::Matrix3d mag = av.transpose() * (a.cwiseAbs() * av);
+  const Eigen::Vector3d s = av.colwise().sum().transpose();
+  double rad[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) rad[i][j] = (err * s(i) * s(j) + kGamma * mag(i, j)) * (1 + kGamma);
+  double bmin_lo = kInf, bmax_hi = -kInf, bmin_hi = kInf, bmax_lo = -kInf;
+  for (int i = 0; i < 3; ++i) {
+    double r = rad[i][i];
+    for (int j = 0; j < 3; ++j)
+      if (j != i) r += std::abs(b(i, j)) + rad[i][j];
+    r *= 1 + kGamma;
+    bmin_lo = std::min(bmin_lo, next_down(b(i, i) - r));  // Gershgorin
+    bmax_hi = std::max(bmax_hi, next_up(b(i, i) + r));
+    bmin_hi = std::min(bmin_hi, next_up(b(i, i) + rad[i][i]));  // Rayleigh quotients
+    bmax_lo = std::max(bmax_lo, next_down(b(i, i) - rad[i][i]));
+  }
+  if (!std::isfinite(bmin_lo) || !std::isfinite(bmax_hi)) return unknown();
+  // Ostrowski: lambda_k(M) = lambda_k(B) / theta_k, theta_k in [1 - eps, 1 + eps].
+  return {divide_down(bmin_lo, eps), divide_up(bmin_hi, eps), divide_down(bmax_lo, eps), divide_up(bmax_hi, eps)};
+}
+
+namespace {
+
+// Sylvester's criterion for the exact symmetric floating-point matrix
+// [a0 a3 a4; a3 a1 a5; a4 a5 a2]: true only if it is positive definite. Each leading minor
+// is computed in at most 5 roundings deep (gamma_5 of the sum of the absolute values of its
+// terms; gamma_8 and (1 + gamma_8) cover the bound's own rounding).
+bool positive_definite3(const double* a) {
+  static const double g = rounding_gamma(8);
+  if (!(a[0] > 0)) return false;
+  const double p01 = a[0] * a[1], s01 = a[3] * a[3];
+  if (!(p01 - s01 > g * (std::abs(p01) + s01) * (1 + g))) return false;
+  const double c0 = a[1] * a[2] - a[5] * a[5];
+  const double c1 = a[3] * a[2] - a[5] * a[4];
+  const double c2 = a[3] * a[5] - a[1] * a[4];
+  const double det = a[0] * c0 - a[3] * c1 + a[4] * c2;
+  const double mag = std::abs(a[0]) * (std::abs(a[1] * a[2]) + a[5] * a[5]) +
+                     std::abs(a[3]) * (std::abs(a[3] * a[2]) + std::abs(a[5] * a[4])) +
+                     std::abs(a[4]) * (std::abs(a[3] * a[5]) + std::abs(a[1] * a[4]));
+  return det > g * mag * (1 + g);
+}
+
+}  // namespace
+
+bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi) {
+  // Eigenvalues q + y of M: y^3 - 3 p^2 y - e3 = 0 with D = M - q I, p^2 = tr D^2 / 6,
+  // e3 = det D; y = 2 p cos(theta + 2 pi k / 3), cos(3 theta) = e3 / (2 p^3).
+  const double q = (m[0] + m[1] + m[2]) / 3;
+  const double d0 = m[0] - q, d1 = m[1] - q, d2 = m[2] - q;
+  const double off = m[3] * m[3] + m[4] * m[4] + m[5] * m[5];
+  const double p2 = (d0 * d0 + d1 * d1 + d2 * d2 + 2 * off) / 6;
+  const double scale = std::abs(q) + 2 * std::sqrt(p2);
+  if (!std::isfinite(scale) || !(scale > 0)) return false;
+  double y_min = 0, y_max = 0;
+  if (p2 > 1e-30 * q * q) {
+    const double p = std::sqrt(p2);
+    const double e3 = d0 * (d1 * d2 - m[5] * m[5]) - m[3] * (m[3] * d2 - m[5] * m[4]) + m[4] * (m[3] * m[5] - d1 * m[4]);
+    const double c = std::clamp(e3 / (2 * p2 * p), -1.0, 1.0);
+    const double theta = std::acos(c) / 3;
+    const double ct = std::cos(theta), st = std::sin(theta);  // one sincos
+    y_max = 2 * p * ct;
+    y_min = 2 * p * (-0.5 * ct - 0.8660254037844386 * st);  // cos(theta + 2 pi / 3)
+    // One Newton step each on y^3 - 3 p^2 y - e3 (accuracy only, not soundness).
+    for (double* y : {&y_min, &y_max}) {
+      const double f = (*y * *y - 3 * p2) * *y - e3, fp = 3 * (*y * *y - p2);
+      if (std::abs(fp) > 1e-3 * p2) {
+        const double step = f / fp;
+        if (std::abs(step) < 1e-3 * p) *y -= step;
+      }
+    }
+  }
+  // Margins: rounding of the approximations and the minors' error bounds (relative to the
+  // matrix's scale), plus the entry errors.
+  const double margin = 1e-12 * scale + 3 * err;
+  const double a = next_down(q + y_min - margin);
+  const double b = next_up(q + y_max + margin);
+  // M - a I - 3 err I >= S (S's diagonal rounded down) and b I - M - 3 err I >= T.
+  const double e3x = next_up(3 * err * (1 + 1e-15));
+  const double sa = next_up(a + e3x), sb = next_down(b - e3x);
+  const double s[6] = {next_down(m[0] - sa), next_down(m[1] - sa), next_down(m[2] - sa), m[3], m[4], m[5]};
+  const double t[6] = {next_down(sb - m[0]), next_down(sb - m[1]), next_down(sb - m[2]), -m[3], -m[4], -m[5]};
+  if (!positive_definite3(s) || !positive_definite3(t)) return false;
+  min_lo = a;
+  max_hi = b;
+  return true;
+}
+
+template <int D>
+double control_ratio_lower(const double* const* entries, const double* err, int size) {
+  constexpr int kEntries = D * (D + 1) / 2;
+  double e = 0;
+  for (int i = 0; i < kEntries; ++i) e = std::max(e, err[i]);
+  double r = 1;
+  double m[kEntries];
+  for (int k = 0; k < size && r > 0; ++k) {
+    for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
+    if constexpr (D == 3) {
+      double lo, hi;
+      if (extreme_eigen_bounds3(m, e, lo, hi)) {
+        r = std::min(r, lo > 0 ? std::clamp(next_down(lo / hi), 0.0, 1.0) : 0.0);
+        continue;
+      }
+    }
+    r = std::min(r, symmetric_eigen_enclosure<D>(m, e).ratio_lower());
+  }
+  return r;
+}
+
+template double control_ratio_lower<2>(const double* const*, const double*, int);
+template double control_ratio_lower<3>(const double* const*, const double*, int);
+
+}  // namespace quadval

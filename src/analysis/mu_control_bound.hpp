@@ -1,0 +1,71 @@
+#pragma once
+// Certified bounds of R = lambda_min / lambda_max of the metric M = W^T W on a subdomain
+// from the Bézier control matrices M_k of M alone (degree 2n, one product of W's control
+// values), with no product of higher degree and no bisection. Internal to src/analysis;
+// used by mu_metric.cpp and mu_bounds.cpp.
+//
+// Why it is a bound. For r >= 0, g_r(M) = lambda_min(M) - r lambda_max(M) is concave on
+// symmetric matrices (lambda_min is concave, lambda_max convex: both are extrema of the
+// Rayleigh quotient, linear in M). On the subdomain M(x) = sum_k B_k(x) M_k with
+// B_k(x) >= 0 summing to 1 (Paper V Prop. 4 gives the M_k exactly), so by Jensen
+//   g_r(M(x)) >= sum_k B_k(x) g_r(M_k) >= min_k g_r(M_k).
+// With r = min_k R_lo(M_k) (R_lo a certified lower bound of lambda_min / lambda_max of
+// the exact M_k, 0 unless M_k is positive definite) every g_r(M_k) >= 0, hence
+// R(x) >= r on the whole subdomain. The control matrices converge to the values of M like
+// h^2 under subdivision, so this bound closes the gap quadratically, as the degree-12n
+// certificate of mu_metric.hpp does, at the cost of one small eigenvalue enclosure per
+// control matrix.
+//
+// Eigenvalue enclosures of one symmetric matrix known within an entrywise error e:
+//   2 x 2: lambda = q +- sqrt(s^2 + t^2) in interval arithmetic (Paper V §4);
+//   3 x 3: V = approximate eigenvectors (Eigen), B = V^T M V enclosed entrywise; the
+//     Gershgorin discs of B bound lambda_min(B) from below and lambda_max(B) from above,
+//     its diagonal (Rayleigh quotients) lambda_min(B) from above and lambda_max(B) from
+//     below; Ostrowski's theorem (Horn & Johnson Thm 4.5.9) transfers them to M with
+//     theta in [1 - eps, 1 + eps], eps >= |V^T V - I|_2. Every rounding is covered.
+
+namespace quadval {
+
+/// Tests and benchmarks: how mu_bounds bounds a subdomain in the calling thread:
+/// 0 the degree-12n certificate of mu_metric.hpp alone, 1 the control-matrix bound alone,
+/// 2 (default) the control-matrix bound, then, once an element has been split 24 times,
+/// the certificate where the control bound falls short.
+void mu_use_control_bound(int mode) noexcept;
+
+/// Certified enclosure of the extreme eigenvalues of a symmetric matrix:
+/// min_lo <= lambda_min <= min_hi and max_lo <= lambda_max <= max_hi.
+struct EigenEnclosure {
+  double min_lo, min_hi, max_lo, max_hi;
+  /// Certified lower bound of lambda_min / lambda_max in [0, 1] (0 unless min_lo > 0).
+  double ratio_lower() const noexcept;
+  /// Certified upper bound of lambda_min / lambda_max in [0, 1] (1 when unknown).
+  double ratio_upper() const noexcept;
+};
+
+/// Enclosure for the exact symmetric D x D matrix M (D = 2 or 3) with
+/// |M_ij - m_ij| <= err for every entry.
+/// @param m  the entries m00, m11, (m22,) m01, (m02, m12)  (3 for D = 2, 6 for D = 3)
+/// @pre err >= 0, entries finite
+template <int D>
+EigenEnclosure symmetric_eigen_enclosure(const double* m, double err);
+
+/// Faster certified bounds min_lo <= lambda_min and lambda_max <= max_hi of the exact
+/// symmetric 3 x 3 matrix M with |M_ij - m_ij| <= err (entries as above), without
+/// eigenvectors: approximate eigenvalues from the trigonometric closed form of the
+/// characteristic polynomial of M - q I (Smith 1961; Paper V App. A), each polished by one
+/// Newton step, then each bound certified by Sylvester's criterion on a shifted matrix
+/// (M - a I, resp. b I - M, minus 3 err I for the entry errors, |E|_2 <= 3 err), its
+/// leading minors evaluated in floating point with a priori error bounds.
+/// @return false when a certification fails (nearly repeated or tiny eigenvalues relative
+///         to rounding): use symmetric_eigen_enclosure then.
+bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi);
+
+/// Certified lower bound of min R over a subdomain (the concavity argument above).
+/// @param entries  D (D + 1) / 2 coefficient vectors of `size` control values each, in the
+///                 order of symmetric_eigen_enclosure (m00, m11, (m22,) m01, ...)
+/// @param err      per entry vector, |exact control value - computed| <= err[i]
+/// @param size     control values per entry (>= 1)
+template <int D>
+double control_ratio_lower(const double* const* entries, const double* err, int size);
+
+}  // namespace quadval

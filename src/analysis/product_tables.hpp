@@ -1,0 +1,34 @@
+#pragma once
+// Rounded Bernstein-product tables (jacobian_product.hpp) made at build time, so that the
+// first use of a common element type costs no exact (GMP) arithmetic: `quadval check` on a
+// small mesh would otherwise spend most of its time building them (milliseconds per type
+// against microseconds for the elements). Internal to src/analysis.
+//
+// tools/gen_product_tables.cpp builds each type's JacobianProduct in exact arithmetic
+// (TableSource::exact), the same code path as any other type, and writes its tables as
+// hexadecimal float literals, which read back to the same doubles bit for bit; CMake runs
+// it and compiles the output into the library. The generator itself links
+// product_tables_none.cpp instead. tests/analysis/product_tables_test.cpp checks that the
+// generated tables equal the exactly built ones bit for bit.
+#include <span>
+
+namespace quadval {
+
+/// One type's tables: the fields of ProductTables (jacobian_product.hpp) as views of
+/// static arrays; index m is SampleMap (0 curved, 1 straight), c the direction.
+struct ProductTableView {
+  int gmsh_id = 0;
+  int num_nodes[2] = {0, 0};
+  std::span<const double> matrix[2][3];
+  double row_sum[2][3] = {};
+  std::span<const double> deriv_inv_mult[3];
+  std::span<const double> inv_mult;
+};
+
+/// The generated tables of a Gmsh type id, or nullptr when none were generated.
+const ProductTableView* generated_product_tables(int gmsh_id) noexcept;
+
+/// The ids of all generated types (for tests).
+std::span<const int> generated_product_table_ids() noexcept;
+
+}  // namespace quadval

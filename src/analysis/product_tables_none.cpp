@@ -1,0 +1,11 @@
+// No generated tables: linked only into the generator (tools/gen_product_tables.cpp), which
+// builds every type's tables in exact arithmetic.
+#include "analysis/product_tables.hpp"
+
+namespace quadval {
+
+const ProductTableView* generated_product_tables(int) noexcept { return nullptr; }
+
+std::span<const int> generated_product_table_ids() noexcept { return {}; }
+
+}  // namespace quadval

@@ -1,0 +1,224 @@
+// The control-matrix bound of mu (src/analysis/mu_control_bound.hpp):
+//  - the eigenvalue enclosure of one symmetric matrix against exact rational arithmetic
+//    (GMP): M - min_lo I and max_hi I - M are positive semidefinite, M - min_hi I and
+//    max_hi I - M are not positive definite (principal minors, exactly), for random,
+//    near-multiple, near-singular and indefinite matrices, also when the matrix is any
+//    point of the error box;
+//  - mu_bounds with the control bound alone, and with the default combination, against
+//    dense sampling of the singular values of W (mu_test_util.hpp, no shared code) on
+//    random curved elements of every family and order up to 3, and the gap closing.
+#include <gtest/gtest.h>
+
+#include <gmpxx.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <array>
+#include <random>
+
+#include "analysis/mu_control_bound.hpp"
+#include "jacobian_test_util.hpp"
+#include "mu_test_util.hpp"
+#include "quadval/mu_bounds.hpp"
+
+namespace quadval {
+namespace {
+
+using Exact = std::array<std::array<mpq_class, 3>, 3>;
+
+// All principal minors of a symmetric D x D rational matrix >= 0 (PSD) or leading ones
+// > 0 (PD), exactly.
+template <int D>
+bool psd(const Exact& a) {
+  for (int i = 0; i < D; ++i)
+    if (a[i][i] < 0) return false;
+  for (int i = 0; i < D; ++i)
+    for (int j = i + 1; j < D; ++j)
+      if (a[i][i] * a[j][j] - a[i][j] * a[i][j] < 0) return false;
+  if (D == 3) {
+    const mpq_class det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[1][2]) -
+                          a[0][1] * (a[0][1] * a[2][2] - a[1][2] * a[0][2]) +
+                          a[0][2] * (a[0][1] * a[1][2] - a[1][1] * a[0][2]);
+    if (det < 0) return false;
+  }
+  return true;
+}
+template <int D>
+bool pd(const Exact& a) {
+  if (!(a[0][0] > 0)) return false;
+  if (!(a[0][0] * a[1][1] - a[0][1] * a[0][1] > 0)) return false;
+  if (D == 2) return true;
+  const mpq_class det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[1][2]) -
+                        a[0][1] * (a[0][1] * a[2][2] - a[1][2] * a[0][2]) +
+                        a[0][2] * (a[0][1] * a[1][2] - a[1][1] * a[0][2]);
+  return det > 0;
+}
+
+// Entry order of symmetric_eigen_enclosure: m00, m11, (m22,) m01, (m02, m12).
+template <int D>
+std::array<std::array<int, 2>, D*(D + 1) / 2> entry_positions() {
+  if constexpr (D == 2) return {{{0, 0}, {1, 1}, {0, 1}}};
+  else return {{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+}
+
+// s (a I - M) for s = +-1, exactly, M from the entries m.
+template <int D>
+Exact shifted(const double* m, double a, int s) {
+  Exact out;
+  const auto pos = entry_positions<D>();
+  for (std::size_t i = 0; i < pos.size(); ++i) {
+    const mpq_class v = mpq_class(-m[i]) * s;
+    out[pos[i][0]][pos[i][1]] = out[pos[i][1]][pos[i][0]] = v;
+  }
+  for (int i = 0; i < D; ++i) out[i][i] += mpq_class(a) * s;
+  return out;
+}
+
+template <int D>
+void check_enclosure_of_random_matrices(unsigned seed) {
+  constexpr int kEntries = D * (D + 1) / 2;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int tight = 0, positive = 0, fast_count = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    // M = Q diag(l) Q^T with chosen spectra: generic, near-multiple, near-singular,
+    // indefinite; then rounded to doubles (the matrix under test is the rounded one).
+    Eigen::Matrix<double, D, D> q = Eigen::Matrix<double, D, D>::Random().householderQr().householderQ();
+    Eigen::Matrix<double, D, 1> l = Eigen::Matrix<double, D, 1>::Random().cwiseAbs() * 3;
+    switch (trial % 5) {
+      case 1: l.setConstant(2.0), l(0) += 1e-9 * u(rng); break;  // near-multiple
+      case 2: l(0) = 1e-7 * std::abs(u(rng)); break;               // near-singular
+      case 3: l(0) = -0.5; break;                                  // indefinite
+      default: break;
+    }
+    const Eigen::Matrix<double, D, D> mm = q * l.asDiagonal() * q.transpose();
+    double m[kEntries];
+    const auto pos = entry_positions<D>();
+    for (int i = 0; i < kEntries; ++i) m[i] = mm(pos[i][0], pos[i][1]);
+    const double err = trial % 2 == 0 ? 0.0 : 1e-6;
+    const EigenEnclosure e = symmetric_eigen_enclosure<D>(m, err);
+    ASSERT_LE(e.min_lo, e.min_hi);
+    ASSERT_LE(e.max_lo, e.max_hi);
+    // The eigenvector-free bounds (3 x 3), when they certify.
+    double f_lo = 0, f_hi = 0;
+    bool fast = false;
+    if constexpr (D == 3) {
+      fast = extreme_eigen_bounds3(m, err, f_lo, f_hi);
+      if (fast) ++fast_count;
+    }
+    // Every matrix of the error box: its corners' signs and a random point.
+    for (int s = 0; s < 3; ++s) {
+      double p[kEntries];
+      for (int i = 0; i < kEntries; ++i)
+        p[i] = m[i] + (s == 0 ? 0.0 : s == 1 ? err * (u(rng) > 0 ? 1 : -1) : err * u(rng));
+      ASSERT_TRUE(psd<D>(shifted<D>(p, e.min_lo, -1))) << "lambda_min < min_lo, trial " << trial;
+      ASSERT_TRUE(psd<D>(shifted<D>(p, e.max_hi, 1))) << "lambda_max > max_hi, trial " << trial;
+      ASSERT_FALSE(pd<D>(shifted<D>(p, e.min_hi, -1))) << "lambda_min > min_hi, trial " << trial;
+      ASSERT_FALSE(pd<D>(shifted<D>(p, e.max_lo, 1))) << "lambda_max < max_lo, trial " << trial;
+      if (fast) {
+        ASSERT_TRUE(psd<D>(shifted<D>(p, f_lo, -1))) << "fast: lambda_min < min_lo, trial " << trial;
+        ASSERT_TRUE(psd<D>(shifted<D>(p, f_hi, 1))) << "fast: lambda_max > max_hi, trial " << trial;
+      }
+    }
+    // Tight: within the margins (1e-12 of the scale, 3 err) of the full enclosure (itself
+    // within ~1e-10 when an eigenvalue is nearly repeated).
+    if (fast && trial % 5 != 3) {
+      const double scale = l.cwiseAbs().maxCoeff();
+      const double rel = trial % 5 == 1 ? 1e-9 : 1e-11;
+      EXPECT_LE(e.min_hi - f_lo, rel * scale + 10 * err) << "trial " << trial;
+      EXPECT_LE(f_hi - e.max_lo, rel * scale + 10 * err) << "trial " << trial;
+    }
+    // Tight to rounding (and err) on well-conditioned positive definite matrices.
+    if (trial % 5 != 3) {
+      ++positive;
+      const double scale = l.cwiseAbs().maxCoeff();
+      const double width = std::max(e.min_hi - e.min_lo, e.max_hi - e.max_lo);
+      // Gershgorin radii carry err times (sum |V_ai|)(sum |V_bj|) <= D err per entry; the
+      // closed-form eigenvectors of a nearly repeated eigenvalue are accurate to ~1e-10.
+      const double rel = trial % 5 == 1 ? 1e-9 : 1e-12;
+      if (width <= rel * scale + 4 * D * D * err) ++tight;
+    }
+  }
+  EXPECT_GE(tight, positive * 99 / 100) << tight << " of " << positive;
+  // The eigenvector-free bounds certify all but the near-singular and near-multiple cases.
+  if (D == 3) {
+    EXPECT_GE(fast_count, 3000 * 3 / 5) << fast_count;
+  }
+}
+
+TEST(MuControlBound, EigenEnclosure2x2MatchesExactArithmetic) { check_enclosure_of_random_matrices<2>(5); }
+TEST(MuControlBound, EigenEnclosure3x3MatchesExactArithmetic) { check_enclosure_of_random_matrices<3>(6); }
+
+TEST(MuControlBound, RatioBoundsOfScaledIdentityAndStretch) {
+  // Closed forms: diag(4, 1, 1) has ratio 1/4; c I has 1.
+  const double m1[6] = {4, 1, 1, 0, 0, 0};
+  const EigenEnclosure e1 = symmetric_eigen_enclosure<3>(m1, 0);
+  EXPECT_LE(e1.ratio_lower(), 0.25);
+  EXPECT_GE(e1.ratio_upper(), 0.25);
+  EXPECT_NEAR(e1.ratio_lower(), 0.25, 1e-14);
+  const double m2[3] = {2.5, 2.5, 0};
+  EXPECT_NEAR(symmetric_eigen_enclosure<2>(m2, 0).ratio_lower(), 1.0, 1e-14);
+  // Indefinite and singular control matrices give 0, never a positive bound.
+  const double m3[6] = {1, 1, -1e-3, 0, 0, 0};
+  EXPECT_EQ(symmetric_eigen_enclosure<3>(m3, 0).ratio_lower(), 0.0);
+  const double m4[3] = {1, 1, 1};
+  EXPECT_EQ(symmetric_eigen_enclosure<2>(m4, 0).ratio_lower(), 0.0);
+}
+
+TEST(MuControlBound, ControlRatioIsMinimumOverControlMatrices) {
+  // Two control matrices per entry vector: diag(1, 1, 1) and diag(9, 1, 1) -> 1/9.
+  const double m00[2] = {1, 9}, m11[2] = {1, 1}, m22[2] = {1, 1}, z[2] = {0, 0};
+  const double* e[6] = {m00, m11, m22, z, z, z};
+  const double err[6] = {0, 0, 0, 0, 0, 0};
+  const double r = control_ratio_lower<3>(e, err, 2);
+  EXPECT_LE(r, 1.0 / 9);
+  EXPECT_NEAR(r, 1.0 / 9, 1e-11);  // the certification margins are 1e-12 relative
+}
+
+// mu_bounds with the given subdomain bound against dense sampling of W's singular values.
+void check_against_sampling(int mode, double tol, unsigned seed) {
+  mu_use_control_bound(mode);
+  std::mt19937 rng(seed);
+  QualityOptions opt;
+  opt.abs_tol = tol;
+  opt.max_subdivisions = 400;
+  int elements = 0, met = 0;
+  for (const ElementType& t : element_types()) {
+    if (t.family == ElementFamily::line || !mu_supported(t) || t.order > 3) continue;
+    SCOPED_TRACE(std::string(t.name));
+    const LagrangeBasis& basis = lagrange_basis(t);
+    const bool heavy = t.dim == 3 && t.order >= 2;
+    const int count = heavy ? 10 : (t.dim == 3 ? 40 : 80);
+    const auto pts = test::dense_points(t.family, t.dim == 3 ? 6 : 12, 60, rng);
+    for (int e = 0; e < count; ++e) {
+      const double amplitude = ((e % 3 == 0) ? 0.02 : (e % 3 == 1 ? 0.08 : 0.15)) / t.order;
+      const auto x = test::random_element(t, amplitude, rng);
+      const QualityBounds b = mu_bounds(t, x, opt, true);
+      ++elements;
+      ASSERT_LE(b.lower, b.upper);
+      ASSERT_GE(b.lower, 0.0);
+      if (b.tolerance_met) ++met;
+      if (b.upper == 0) continue;
+      double lo = 1, hi = 0;
+      bool negative = false;
+      for (const auto& p : pts) {
+        if (test::jacobian_at(basis, x, p, true) <= 0) negative = true;
+        const double m = test::pointwise_mu(basis, x, p);
+        lo = std::min(lo, m);
+        hi = std::max(hi, m);
+      }
+      if (negative) continue;
+      ASSERT_GE(lo, b.lower - 1e-13) << "element " << e;
+      ASSERT_LE(b.upper, hi + 1e-13) << "element " << e;
+    }
+  }
+  mu_use_control_bound(2);
+  EXPECT_GE(met, elements * 97 / 100) << met << " of " << elements;
+}
+
+TEST(MuControlBound, ControlBoundAloneNeverAboveSampledMinimum) { check_against_sampling(1, 1e-3, 31); }
+TEST(MuControlBound, DefaultCombinationNeverAboveSampledMinimum) { check_against_sampling(2, 1e-3, 32); }
+
+}  // namespace
+}  // namespace quadval

@@ -1,0 +1,100 @@
+// The build-time product tables (src/analysis/product_tables.hpp): bit for bit the tables
+// that exact arithmetic gives at run time, used by jacobian_space for the common types, and
+// the exact data the generated path builds lazily agrees with them.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "analysis/jacobian_product.hpp"
+#include "analysis/jacobian_space.hpp"
+#include "analysis/product_tables.hpp"
+#include "jacobian_test_util.hpp"
+
+namespace quadval {
+namespace {
+
+// Bitwise equality (0.0 and -0.0 differ; NaN would not compare unequal to itself).
+void expect_same_bits(std::span<const double> got, std::span<const double> want, const std::string& what) {
+  ASSERT_EQ(got.size(), want.size()) << what;
+  for (std::size_t i = 0; i < got.size(); ++i)
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(got[i]), std::bit_cast<std::uint64_t>(want[i]))
+        << what << " entry " << i << ": " << got[i] << " vs " << want[i];
+}
+
+void expect_same_tables(const ProductTables& got, const ProductTables& want, const std::string& name) {
+  for (std::size_t m = 0; m < 2; ++m) {
+    const std::string map = name + (m == 0 ? " curved" : " straight");
+    EXPECT_EQ(got.maps[m].num_nodes, want.maps[m].num_nodes) << map;
+    for (std::size_t c = 0; c < 3; ++c) {
+      expect_same_bits(got.maps[m].matrix[c], want.maps[m].matrix[c], map + " matrix " + std::to_string(c));
+      expect_same_bits(std::span(&got.maps[m].row_sum[c], 1), std::span(&want.maps[m].row_sum[c], 1),
+                       map + " row sum " + std::to_string(c));
+    }
+  }
+  for (std::size_t c = 0; c < 3; ++c)
+    expect_same_bits(got.deriv_inv_mult[c], want.deriv_inv_mult[c], name + " 1/mult " + std::to_string(c));
+  expect_same_bits(got.inv_mult, want.inv_mult, name + " 1/mult of J");
+}
+
+TEST(ProductTables, GeneratedEqualExactlyBuiltBitForBit) {
+  const auto ids = generated_product_table_ids();
+  ASSERT_GE(ids.size(), 40u);  // every common type of the six families
+  for (int id : ids) {
+    const ElementType& type = *find_element_type(id);
+    SCOPED_TRACE(std::string(type.name));
+    const BezierBasis& basis = bezier_basis(type.family, type.order);
+    const ProductTables exact = JacobianProduct(type, basis, TableSource::exact).tables();
+    // What the view holds, and what a product built from it (the shared space) uses.
+    const ProductTableView& view = *generated_product_tables(id);
+    ProductTables from_view;
+    for (std::size_t m = 0; m < 2; ++m) {
+      from_view.maps[m].num_nodes = view.num_nodes[m];
+      for (std::size_t c = 0; c < 3; ++c) {
+        from_view.maps[m].matrix[c].assign(view.matrix[m][c].begin(), view.matrix[m][c].end());
+        from_view.maps[m].row_sum[c] = view.row_sum[m][c];
+      }
+    }
+    for (std::size_t c = 0; c < 3; ++c)
+      from_view.deriv_inv_mult[c].assign(view.deriv_inv_mult[c].begin(), view.deriv_inv_mult[c].end());
+    from_view.inv_mult.assign(view.inv_mult.begin(), view.inv_mult.end());
+    expect_same_tables(from_view, exact, std::string(type.name));
+    expect_same_tables(jacobian_space(type).product()->tables(), exact, std::string(type.name));
+  }
+}
+
+TEST(ProductTables, CommonTypesAreGenerated) {
+  // The types of the benchmark meshes and of everyday Gmsh output, orders 1-3 (4 in 2D).
+  for (int id : {1, 2, 3, 4, 5, 6, 8, 9, 10, 11, 12, 13, 16, 17, 18, 21, 23, 29, 36, 92})
+    EXPECT_NE(generated_product_tables(id), nullptr) << find_element_type(id)->name;
+  EXPECT_EQ(generated_product_tables(7), nullptr);   // pyramid: its own exact path
+  EXPECT_EQ(generated_product_tables(93), nullptr);  // hexahedron of order 4: lazy exact path
+}
+
+TEST(ProductTables, LazyExactDataAgreesWithGeneratedTables) {
+  // A product from generated tables builds its exact data only for exact_coefficients: the
+  // rounded coefficients must lie within their error bound of those exact ones.
+  std::mt19937 rng(5);
+  for (int id : {5, 11, 12, 17, 18, 29, 36, 9, 23, 26}) {
+    const ElementType& type = *find_element_type(id);
+    SCOPED_TRACE(std::string(type.name));
+    const JacobianProduct product(type, bezier_basis(type.family, type.order));
+    const std::vector<double> x = test::random_element(type, 0.15, rng);
+    const auto size = static_cast<std::size_t>(bezier_basis(type.family, type.order).size());
+    std::vector<double> coeffs(size);
+    double err = 0;
+    ProductScratch scratch;
+    product.coefficients(SampleMap::curved, x.data(), 1, type.dim == 2, coeffs.data(), &err, scratch);
+    const std::vector<mpq_class> exact = product.exact_coefficients(SampleMap::curved, x.data(), type.dim == 2);
+    ASSERT_EQ(exact.size(), size);
+    for (std::size_t k = 0; k < size; ++k)
+      ASSERT_TRUE(abs(mpq_class(coeffs[k]) - exact[k]) <= mpq_class(err)) << "coefficient " << k;
+  }
+}
+
+}  // namespace
+}  // namespace quadval
