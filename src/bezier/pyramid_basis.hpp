@@ -14,21 +14,20 @@
 // corner value: check's first-order fast path uses that, analysis/linear_jacobian.hpp;
 // the degree-(2, 2) coefficients here are those corner values degree-elevated.)
 //
-// The generalized basis of eq. (4) (B_i^(k+2)(u) B_j^(k+2)(v) B_k^(3r-3)(t)) spans the same
-// J (J = sum_k B_k(t) P_k(u, v) with deg P_k <= k+2). Both bases share the t factor, so
-// the enriched slice k is the generalized slice k degree-elevated from k+2 to 3r-1: each
-// enriched coefficient is a convex combination of generalized ones of its slice, corners
-// equal, and the slice k = 3r-3 (the base face) is not elevated at all. Hence at level 0
-// the enriched min is >= the generalized min and eq. 4 never settles a sign eq. 6 leaves
-// open. Measured once in exact rationals on the 1,296 order-2 pyramids of ../shared/data
-// and on 20 random pyramids each of orders 2 and 3: the two minima were equal on every
-// element, the same elements decided; tests/analysis/pyramid_jacobian_test.cpp
-// (GeneralizedBasisOfEq4*) asserts the inequality on the random order-2 ones. Its only
-// possible gain would be speed (86 vs 144 coefficients at r = 2, 280 vs 567 at r = 3), but it is not a tensor
-// space: no Bernstein products and no subdivision, only a sample-based Lagrange-to-Bézier
-// matrix (at r = 2 about 86 x 14 x 9 products for the samples plus 86^2 for the transform,
-// ~3x the product path's work, and a rounding bound scaled by that matrix's norm). So
-// quadval computes only the enriched coefficients, as Bernstein products of the
+// The generalized basis of eq. (4) (B_i^(k+2)(u) B_j^(k+2)(v) B_k^(3r-3)(t)) spans the same J (J =
+// sum_k B_k(t) P_k(u, v) with deg P_k <= k+2). Both bases share the t factor, so the enriched slice
+// k is the generalized slice k degree-elevated from k+2 to 3r-1: each enriched coefficient is a
+// convex combination of generalized ones of its slice, corners equal, and the slice k = 3r-3 (the
+// base face) is not elevated at all. Hence at level 0 the enriched min is >= the generalized min
+// and eq. 4 never settles a sign eq. 6 leaves open. Measured once in exact rationals on the 1,296
+// order-2 pyramids of ../shared/data and on 20 random pyramids each of orders 2 and 3: the two
+// minima were equal on every element, the same elements decided;
+// tests/analysis/pyramid_jacobian_test.cpp (GeneralizedBasisOfEq4*) asserts the inequality on the
+// random order-2 ones. Its only possible gain would be speed (86 vs 144 coefficients at r = 2, 280
+// vs 567 at r = 3), but it is not a tensor space: no Bernstein products and no subdivision, only a
+// sample-based Lagrange-to-Bézier matrix (at r = 2 about 86 x 14 x 9 products for the samples plus
+// 86^2 for the transform, ~3x the product path's work, and a rounding bound scaled by that matrix's
+// norm). So quadval computes only the enriched coefficients, as Bernstein products of the
 // derivatives (src/analysis/pyramid_space.cpp); pyramid_generalized_size documents eq. 4's
 // dimension for comparison.
 #include <array>
