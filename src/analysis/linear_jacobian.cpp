@@ -234,8 +234,10 @@ inline Lanes next_down_finite(Lanes x) {
 }
 
 // The whole decision, kLanes elements at a time: coefficients, their min / max / sum, the
-// outward-rounded bounds and the verdict all in vector registers (the same IEEE operations
-// in the same order as one element at a time); only the final stores are per element.
+// outward-rounded bounds and the verdict all in vector registers, branch-free (bit for bit
+// the bounds of one element at a time with next_up / next_down, as the test
+// LinearFastPath.ChunkBoundsAreTheDocumentedOutwardRoundedValues checks); only the final
+// stores are per element.
 template <LinearKind kKind>
 void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, bool* decided) {
   constexpr int n = num_coefficients(kKind);
@@ -249,8 +251,9 @@ void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, boo
       return r;
     };
     Lanes c[n];
-    // err (before rounding up) is a positive normal number (every L in [2^-200, 2^200]) or
-    // +inf, never 0: next_up is bits + 1, and +inf becomes a NaN, which decides nothing.
+    // err (before rounding up) is a positive normal number (every L in [2^-200, 2^200]),
+    // +inf, or a quiet NaN (NaN input), never 0: next_up is bits + 1 for the first, and
+    // the others become (or stay) NaN, which decides nothing.
     const Lanes err = next_up_nonzero(coefficients_of(kKind, point, c));
     // (sum from c[0], not 0 + c[0]: the same bits for every finite c[0], -0 included,
     // and a non-finite c[0] leaves the element undecided either way)
