@@ -25,6 +25,7 @@
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "analysis/stage_clock.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
 #include "quadval/mu_bounds.hpp"
@@ -42,19 +43,19 @@ double now_seconds() {
 }
 
 // Per-thread accumulators, merged at the end (sums are order-independent integers; the
-// times are only reported).
+// times, in stage_ticks, are only reported).
 struct ThreadStats {
   CheckSummary summary;  // histograms and worst lists of this thread's elements
   std::vector<StageRow> stages;
   std::size_t exact = 0;
   std::map<int, std::array<std::size_t, 4>> counts;  // as CheckReport::counts
   QualityCounts mu, sj;
-  void add(int stage, Validity v, double seconds) {
+  void add(int stage, Validity v, double ticks) {
     const auto row = static_cast<std::size_t>(stage < 0 ? 0 : stage);
     if (stages.size() <= row) stages.resize(row + 1);
     if (v == Validity::valid) ++stages[row].valid;
     if (v == Validity::invalid) ++stages[row].invalid;
-    stages[row].seconds += seconds;
+    stages[row].seconds += ticks;  // converted to seconds when merged
   }
 };
 
@@ -69,6 +70,7 @@ std::string stage_name(std::size_t i) {
 CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, const std::string& file,
                                  const CheckSink& sink) {
   const double t0 = now_seconds();
+  const StageClockRate tick_rate;
   double sink_seconds = 0;
   CheckSummary report = empty_summary(file, options.measure, options.worst);
   report.dimension = mesh.dimension();
@@ -278,7 +280,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (!out.tolerance_met) ++qc.tolerance_not_met;
             };
             // What every analysed element gets once its bounds are known.
-            const auto finish = [&](std::size_t index, const double* xe, double seconds) {
+            const auto finish = [&](std::size_t index, const double* xe, double ticks) {
               ElementCheck& ec = elements[index];
               ec.analysed = true;
               const JacobianBounds& b = ec.bounds;
@@ -293,12 +295,12 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                         [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
                                          bool planar) { return scaled_jacobian_bounds_given(t, x, q, planar, v); });
               if (b.exact) ++st.exact;
-              st.add(b.stage, b.validity, seconds);
+              st.add(b.stage, b.validity, ticks);
             };
             if (fast != LinearKind::none) {
               // First-order fast path (linear_jacobian.hpp): the coefficients straight from
               // the vertices; the few it leaves open go one by one to the general path.
-              const double ts = now_seconds();
+              const std::uint64_t ts = stage_ticks();
               const auto nv = static_cast<std::size_t>(linear_num_vertices(fast));
               soa.resize(nv * 3 * kLinearChunk);
               for (std::size_t i = 0; i < ch.count; ++i) {
@@ -309,7 +311,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               }
               fast_bounds.resize(ch.count);
               linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
-              const double share = (now_seconds() - ts) / static_cast<double>(ch.count);
+              const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
               nodes.resize(nn * 3);
               errors.resize(1);
               for (std::size_t i = 0; i < ch.count; ++i) {
@@ -320,7 +322,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   finish(ch.out + i, nullptr, share);  // no distortion: fast_path is validity only
                   continue;
                 }
-                const double te = now_seconds();
+                const std::uint64_t te = stage_ticks();
                 const JacobianSpace& space = jacobian_space(type);
                 coeffs.resize(static_cast<std::size_t>(space.basis().size()));
                 for (std::size_t k = 0; k < nn; ++k)
@@ -330,7 +332,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                                       errors.data(), ws.sample_scratch.product);
                 ec.bounds = bounds_from_coefficients(space, coeffs.data(), errors[0], nodes.data(),
                                                      report.planar, bo, ws);
-                finish(ch.out + i, nodes.data(), share + (now_seconds() - te));
+                finish(ch.out + i, nodes.data(), share + static_cast<double>(stage_ticks() - te));
               }
             } else {
               // The product path (jacobian_product.hpp): the chunk's Bézier coefficients of J
@@ -347,17 +349,17 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               }
               coeffs.resize(ch.count * s);
               errors.resize(ch.count);
-              const double ts = now_seconds();
+              const std::uint64_t ts = stage_ticks();
               jacobian_coefficients(space, nodes.data(), ch.count, report.planar, coeffs.data(),
                                     errors.data(), ws.sample_scratch.product);
-              const double batch_share = (now_seconds() - ts) / static_cast<double>(ch.count);
+              const double batch_share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
               for (std::size_t i = 0; i < ch.count; ++i) {
-                const double te = now_seconds();
+                const std::uint64_t te = stage_ticks();
                 ElementCheck& ec = elements[ch.out + i];
                 const double* xe = nodes.data() + i * nn * 3;
                 ec.bounds = bounds_from_coefficients(space, coeffs.data() + i * s, errors[i], xe,
                                                      report.planar, bo, ws);
-                finish(ch.out + i, xe, batch_share + (now_seconds() - te));
+                finish(ch.out + i, xe, batch_share + static_cast<double>(stage_ticks() - te));
               }
             }
           }
@@ -394,6 +396,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   }
   if (failure) std::rethrow_exception(failure);
 
+  const double seconds_per_tick = tick_rate.seconds_per_tick();
   for (const ThreadStats& st : stats) {
     merge_summary(report, st.summary);
     report.exact_fallbacks += st.exact;
@@ -409,7 +412,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     for (std::size_t i = 0; i < st.stages.size(); ++i) {
       report.stages[i].valid += st.stages[i].valid;
       report.stages[i].invalid += st.stages[i].invalid;
-      report.stages[i].seconds += st.stages[i].seconds;
+      report.stages[i].seconds += st.stages[i].seconds * seconds_per_tick;
     }
   }
   if (report.stages.size() < 2) report.stages.resize(2);
