@@ -10,10 +10,13 @@
 #include <benchmark/benchmark.h>
 
 #include <array>
+#include <cstdlib>
+#include <filesystem>
 #include <random>
 #include <utility>
 
 #include "quadval/check_report.hpp"
+#include "quadval/io.hpp"
 #include "quadval/lagrange_basis.hpp"
 
 namespace quadval {
@@ -176,6 +179,42 @@ BENCHMARK(BM_CheckCurvedType)
     ->ArgsProduct({{100000}, {1, 2}, {12, 92, 19}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// check as `quadval check FILE -q` runs it (streamed, summary only) on each curved mesh of
+// ../shared/data, the meshes of bench/compare_gmsh_check.py: small ones, where fixed and
+// per-element costs show. The shared folder is $QUADVAL_SHARED_DIR, else ../shared beside the
+// repository; an error row when a file is absent.
+void BM_CheckSharedCurved(benchmark::State& state, const std::string& name) {
+  const char* env = std::getenv("QUADVAL_SHARED_DIR");
+  const std::string dir =
+      env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
+  Mesh mesh;
+  try {
+    mesh = read_mesh(dir + "/data/curved/" + name + ".msh");
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  CheckOptions o;
+  o.threads = static_cast<int>(state.range(0));
+  for (auto _ : state)
+    benchmark::DoNotOptimize(check_mesh_streamed(mesh, o, name, [](const CheckBatch&) {}));
+  state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
+}
+const bool kSharedCurvedRegistered = [] {
+  for (const char* name :
+       {"hex_box_N20_amp0.35_seed777", "mixed_h0.6_o2", "quad_h0.4_o2", "tets_h0.8_o2",
+        "tri_h0.4_o4", "warped_hexahedron_o2_N6_a0.25", "warped_prism_o2_N6_a0.25",
+        "warped_pyramid_o1_N6_a0.1", "warped_pyramid_o2_N6_a0.15",
+        "warped_tetrahedron_o3_N6_a0.25"})
+    benchmark::RegisterBenchmark((std::string("BM_CheckSharedCurved/") + name).c_str(),
+                                 [name](benchmark::State& s) { BM_CheckSharedCurved(s, name); })
+        ->Arg(1)
+        ->Arg(2)
+        ->Unit(benchmark::kMicrosecond);
+  return true;
+}();
 
 }  // namespace
 }  // namespace quadval

@@ -86,26 +86,6 @@ void BM_LinearChunkHexahedron(benchmark::State& s) { bm_linear_chunk(s, ElementF
 BENCHMARK(BM_LinearChunkPyramid);
 BENCHMARK(BM_LinearChunkHexahedron);
 
-// check_mesh (validity, one thread) on Gmsh's warped first-order pyramid mesh (1,296
-// elements), the case where fixed costs show: the mesh from $QUADVAL_SHARED_DIR (default
-// ../shared beside the repository) is read once; an error row when absent.
-void BM_CheckWarpedPyramidO1(benchmark::State& state) {
-  const char* env = std::getenv("QUADVAL_SHARED_DIR");
-  const std::string dir = env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
-  Mesh mesh;
-  try {
-    mesh = read_mesh(dir + "/data/curved/warped_pyramid_o1_N6_a0.1.msh");
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
-  CheckOptions o;
-  o.threads = 1;
-  for (auto _ : state) benchmark::DoNotOptimize(check_mesh(mesh, o));
-  state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
-                                                    benchmark::Counter::kIsIterationInvariantRate);
-}
-BENCHMARK(BM_CheckWarpedPyramidO1)->Unit(benchmark::kMicrosecond);
 
 void BM_PyramidBounds(benchmark::State& s) { bm_bounds(s, ElementFamily::pyramid); }
 void BM_HexahedronBounds(benchmark::State& s) { bm_bounds(s, ElementFamily::hexahedron); }
