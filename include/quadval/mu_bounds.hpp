@@ -62,6 +62,21 @@
 /// upper: the minimum over the corners of all subdomains of an upper bound of mu_pw there
 ///   (Rayleigh quotients of W at approximate eigenvectors of W^T W, enclosed in interval
 ///   fashion: lambda_min <= |W v|^2 / |v|^2 <= lambda_max for any v).
+/// Pyramids (orders 1 and 2). Bergot's map is rational in (xi, eta, zeta), but in the cube
+///   coordinates u = (xi/t + 1)/2, v = (eta/t + 1)/2, t = 1 - zeta (bezier/pyramid_basis.hpp)
+///   the columns X_xi, X_eta, X_zeta of J_p (Gmsh's directions) are polynomials of degrees
+///   (r-1, r, r-1), (r, r-1, r-1), (r, r, r-1) (src/analysis/pyramid_space.hpp): W is a
+///   polynomial, bounded and continuous on the closed cube, and is taken there in the
+///   tensor Bernstein space of degree r per axis, split like a hexahedron's. The cube minus
+///   its face t = 0 maps one-to-one onto the pyramid minus its apex; the face t = 0 collapses
+///   onto the apex, where J_p has no value (its limit depends on the ray (u, v)) and nothing
+///   is evaluated: that face holds only the limits of W along the rays. So, with W and J
+///   extended continuously to the closed cube (as the Jacobian engine takes J),
+///     mu(E) = inf over the pyramid minus its apex of mu_pw = min over the closed cube,
+///   because mu_pw is continuous where W is nonsingular (J > 0 on the closed cube) and the
+///   points with t > 0 are dense. Every bound above is a bound of that minimum; the corner
+///   values on t = 0 used by `upper` are limits of values inside the element, hence still
+///   upper bounds of the infimum. A limit J <= 0 on t = 0 counts as J <= 0 (mu = 0).
 /// Refinement is best-first (the subdomain with the smallest lower bound is split into its
 /// 2^dim children) until upper - lower <= abs_tol or max_subdivisions subdomains were
 /// split; tolerance_met says which.
@@ -74,9 +89,9 @@
 namespace quadval {
 
 /// True when mu_bounds handles this type: Lagrange lines (any order), triangles and
-/// quadrangles up to order 6, tetrahedra up to order 3, prisms and hexahedra up to order 2
-/// (complete and incomplete), within what jacobian_bounds_supported() accepts. The limit
-/// is the cost of the degree-12n certificate of 3D elements. Pyramids are not handled.
+/// quadrangles up to order 6, tetrahedra up to order 3, prisms, hexahedra and pyramids up
+/// to order 2 (complete and incomplete), within what jacobian_bounds_supported() accepts.
+/// The limit is the cost of the degree-12n certificate of 3D elements.
 bool mu_supported(const ElementType& type) noexcept;
 
 /// Certified bounds of mu(E) for one element. Thread-safe (thread_local scratch) and

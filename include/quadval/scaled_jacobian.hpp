@@ -21,19 +21,30 @@
 ///   prism      the 3 triangle-corner frames in (xi, eta) times the axis c_3, s = 2/sqrt(3)
 ///   line       E = 1: sj = (c_1 . t) / |c_1|, the cosine of the angle between the tangent
 ///              and the chord direction t, s = 1
+///   pyramid    the 4 base-corner frames: at base vertex k of Gmsh's reference pyramid the
+///              half base edges to the next and the previous base vertex and the edge to
+///              the apex (e.g. corner 0: (1,0,0), (0,1,0), (1,1,1)), s = sqrt(2); at a
+///              straight pyramid whose base is a parallelogram this is the minimum of the
+///              four corner-tetrahedron values sqrt(2) det[e_next, e_prev, e_apex] /
+///              (|e_next| |e_prev| |e_apex|). The columns are polynomials in the cube
+///              coordinates (u, v, t) (mu_bounds.hpp, "Pyramids"): sj is bounded over the
+///              closed cube, whose face t = 0 holds the limits along the rays into the apex
+///              (the apex itself, where J_p is undefined, is never evaluated); sj(E) is the
+///              infimum over the pyramid minus its apex, which is that minimum.
 /// At a straight-sided simplex this is the classic corner scaled Jacobian (the frames of
 /// the affinely mapped reference element are its corner edge frames). The element value
 /// is sj(E) = min over the element of sj(xi).
 /// Ideal value 1: unit square/cube, any rectangle/box, equilateral triangle, regular
-/// tetrahedron, right prism on an equilateral triangle; a parallelogram gives the sine of
-/// its angle. Range: sj <= 1 for quadrangles, hexahedra, triangles, prisms and lines (the
+/// tetrahedron, right prism on an equilateral triangle, the pyramid with a square base and
+/// equilateral triangular faces; a parallelogram gives the sine of its angle. Range: sj <= 1 for quadrangles, hexahedra, triangles, prisms and lines (the
 /// smallest corner angle of a triangle is at most 60 degrees); for tetrahedra sj <= 1
 /// held on every tetrahedron we sampled (10^6 random and 10^6 near-regular ones) but we
 /// know no proof, so nothing is clamped: a value is reported as computed. Below, sj >= -s
 /// (Hadamard): an inverted element takes the most negative corner, e.g. -2/sqrt(3) for an
 /// inverted right triangle, -sqrt(2) for an inverted corner tetrahedron. Negative values
-/// mean J < 0 there.
-/// Pyramids are not supported (their map is rational, Paper IV).
+/// mean J < 0 there. Pyramids: one corner value reaches sqrt(2) where that corner's three
+/// edges are orthogonal, and sj <= 1 is not proven for the minimum over the corners
+/// either: nothing is clamped, sj lies in [-sqrt(2), sqrt(2)] (Hadamard).
 ///
 /// What is guaranteed. The node coordinates (doubles) are taken as exact. Then
 ///   lower <= sj(E) <= upper.
@@ -61,14 +72,15 @@
 namespace quadval {
 
 /// True when scaled_jacobian_bounds handles this type: Lagrange lines, triangles,
-/// quadrangles, tetrahedra, prisms and hexahedra (complete and incomplete) up to the
-/// orders of scaled_jacobian_max_order.
+/// quadrangles, tetrahedra, prisms, hexahedra and pyramids (complete and incomplete) up to
+/// the orders of scaled_jacobian_max_order.
 bool scaled_jacobian_supported(const ElementType& type) noexcept;
 
 /// Highest order handled per family: lines, triangles and quadrangles 6, tetrahedra,
 /// prisms and hexahedra 3 (N and D_k have twice the degree of J: a tetrahedron of order 3
-/// already has 455 coefficients per subdomain and vector, a hexahedron 4913); 0 for the
-/// other families.
+/// already has 455 coefficients per subdomain and vector, a hexahedron 4913); pyramids 2
+/// (columns of degree r per cube axis, N and D_k of degree 6r: 2197 coefficients at r = 2);
+/// 0 for the other families.
 int scaled_jacobian_max_order(ElementFamily family) noexcept;
 
 /// Certified bounds of sj(E) (definition above) for one element. Thread-safe

@@ -39,7 +39,7 @@ void quality_section(std::string& out, const CheckSummary& r, bool sj, std::size
   const QualityCounts& qc = qs.counts;
   const char* name = sj ? "scaled Jacobian" : "mu";
   out += fmt::format("  {} ({}): computed {}, skipped {}, tolerance not met {}\n", name,
-                     sj ? "min of det J / product of column norms, corner frames for simplices"
+                     sj ? "min of det J / product of column norms, corner frames for simplices, prisms, pyramids"
                         : "min of sqrt(lambda_min / lambda_max) of W^T W, Paper V",
                      qc.computed, qc.skipped, qc.tolerance_not_met);
   for (const auto& [id, n] : qc.skipped_types) {

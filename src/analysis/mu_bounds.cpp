@@ -89,7 +89,8 @@ bool handled_family(ElementFamily f) {
     case ElementFamily::quadrangle:
     case ElementFamily::tetrahedron:
     case ElementFamily::prism:
-    case ElementFamily::hexahedron: return true;
+    case ElementFamily::hexahedron:
+    case ElementFamily::pyramid: return true;
     default: return false;
   }
 }

@@ -13,6 +13,7 @@
 
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
+#include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
@@ -122,6 +123,9 @@ std::array<double, 9> ideal_inverse_of(ElementFamily f) {
     case ElementFamily::prism: return {1, -r3, 0, 0, 2 / std::sqrt(3.0), 0, 0, 0, 2};
     case ElementFamily::quadrangle: return {1, 0, 0, 0, 1, 0, 0, 0, 0};
     case ElementFamily::hexahedron: return {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    // Gmsh's pyramid (base [-1,1]^2, apex (0,0,1)) to the ideal one (unit square base,
+    // apex height 1/sqrt 2) is affine, J_i = diag(1/2, 1/2, 1/sqrt 2); scaled by 1/2.
+    case ElementFamily::pyramid: return {1, 0, 0, 0, 1, 0, 0, 0, 1 / std::sqrt(2.0)};
     default: return {};
   }
 }
@@ -135,36 +139,106 @@ int mu_max_order(ElementFamily family) noexcept {
     case ElementFamily::quadrangle: return 6;
     case ElementFamily::tetrahedron: return 3;  // 12 n = 24: 2925 coefficients
     case ElementFamily::prism:
-    case ElementFamily::hexahedron: return 2;   // 12 n = 24 per factor: 15625 (hexahedron)
+    case ElementFamily::hexahedron:
+    case ElementFamily::pyramid: return 2;      // 12 n = 24 per factor: 15625 (hexahedron)
     default: return 0;
   }
 }
 
-MuSpace::MuSpace(const ElementType& type) : type_(&type) {
-  const auto shapes = factor_shapes(type.family);
-  QV_ASSERT(!shapes.empty() && type.has_lagrange_basis && type.order >= 1 &&
-                type.order <= mu_max_order(type.family),
-            "no mu space for " << type.name);
-  const int p = type.order;
-  dim_ = type.dim;
-  num_nodes_ = type.num_nodes;
-  const auto nf = static_cast<int>(shapes.size());
-  const bool simplex = simplicial(type.family);
-
-  // W space and product degrees.
+void MuSpace::init_w_space(const std::vector<int>& factor_dims, int n) {
   std::vector<const BernsteinSimplex*> w_factors;
-  for (const FactorShape& s : shapes) {
-    const int n = simplex ? p - 1 : p;
-    for (int m : {1, 2, 4, 6, 8, 12}) degrees_[m].push_back({s.dim, m * n});
-    w_factors.push_back(&bernstein_simplex(s.dim, n));
+  for (int d : factor_dims) {
+    for (int m : {1, 2, 4, 6, 8, 12}) degrees_[m].push_back({d, m * n});
+    w_factors.push_back(&bernstein_simplex(d, n));
   }
   for (int m : {1, 2, 4, 6, 8, 12}) sizes_[m] = bernstein_space_size(degrees_[m]);
-  w_basis_ = std::make_unique<BezierBasis>(type.family, type.order, w_factors);
+  w_basis_ = std::make_unique<BezierBasis>(type_->family, type_->order, w_factors);
   std::vector<std::pair<int, int>> pairs{{1, 1}, {2, 2}};
   if (dim_ == 3) pairs.insert(pairs.end(), {{4, 2}, {2, 4}, {4, 4}, {8, 4}, {6, 6}});
   for (const auto& [a, b] : pairs)
     prod_.push_back({{a, b}, &bernstein_product(degrees_[a], degrees_[b])});
-  ideal_inv_ = ideal_inverse_of(type.family);
+  ideal_inv_ = ideal_inverse_of(type_->family);
+}
+
+PyramidColumnMaps pyramid_column_maps(const ElementType& type) {
+  QV_ASSERT(type.family == ElementFamily::pyramid && type.has_lagrange_basis && type.order >= 1,
+            type.name << " is no Lagrange pyramid");
+  const int r = type.order;
+  const auto n = static_cast<std::size_t>(type.num_nodes);
+  const PyramidShapeCoefficients sc = pyramid_shape_coefficients(type);
+  const auto ws = static_cast<std::size_t>((r + 1) * (r + 1) * (r + 1));
+  PyramidColumnMaps out;
+  for (int c = 0; c < 3; ++c) {
+    // Per axis: Bernstein coefficients from pyramid_scaled_derivative's scaled ones
+    // (divide by C(deg, i)), then degree elevation deg -> r. Separable, exact.
+    const std::array<int, 3> deg = pyramid_derivative_degrees(r, c);
+    std::array<Matrix, 3> axis;
+    for (std::size_t h = 0; h < 3; ++h) {
+      const int a = deg[h];
+      Matrix m(static_cast<std::size_t>((a + 1) * (a + 1)), mpq_class(0));
+      for (int i = 0; i <= a; ++i) {
+        mpz_class b;
+        mpz_bin_uiui(b.get_mpz_t(), static_cast<unsigned long>(a), static_cast<unsigned long>(i));
+        m[static_cast<std::size_t>(i * (a + 1) + i)] = mpq_class(mpz_class(1), b);
+      }
+      for (int e = a; e < r; ++e) m = multiply(elevation_matrix(1, e), m, e + 2, e + 1, a + 1);
+      axis[h] = std::move(m);
+    }
+    auto& map = out.map[static_cast<std::size_t>(c)];
+    map.assign(ws * n, 0.0);
+    std::vector<double> row_abs(ws, 0.0);
+    std::vector<mpq_class> column(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t j = 0; j < n; ++j) column[j] = sc.coefficients[j * n + i];
+      Matrix col = pyramid_scaled_derivative(r, c, sc.exponents, column);
+      std::array<int, 3> sizes{deg[0] + 1, deg[1] + 1, deg[2] + 1};
+      for (int h = 0; h < 3; ++h) col = apply_factor(col, sizes, h, axis[static_cast<std::size_t>(h)], r + 1);
+      QV_ASSERT(col.size() == ws, "pyramid derivative map size " << col.size() << " vs " << ws);
+      for (std::size_t k = 0; k < ws; ++k) {
+        const double v = nearest_double(col[k]);
+        map[k * n + i] = v;
+        row_abs[k] += std::abs(v);
+      }
+    }
+    double row_sum_max = 0;
+    for (double s : row_abs) row_sum_max = std::max(row_sum_max, s);
+    // |exact| <= |rounded| (1 + u), and the sum's own rounding.
+    out.row_sum[static_cast<std::size_t>(c)] = row_sum_max * (1 + 1e-12 + rounding_gamma(static_cast<int>(n) + 2));
+  }
+  return out;
+}
+
+void MuSpace::init_pyramid_derivatives() {
+  PyramidColumnMaps maps = pyramid_column_maps(*type_);
+  QV_ASSERT(maps.map[0].size() == static_cast<std::size_t>(w_basis_->size() * num_nodes_), "pyramid W space");
+  for (std::size_t c = 0; c < 3; ++c) {
+    deriv_[c] = std::move(maps.map[c]);
+    row_sum_[c] = maps.row_sum[c];
+  }
+}
+
+MuSpace::MuSpace(const ElementType& type) : type_(&type) {
+  QV_ASSERT(type.has_lagrange_basis && type.order >= 1 && type.order <= mu_max_order(type.family),
+            "no mu space for " << type.name);
+  dim_ = type.dim;
+  num_nodes_ = type.num_nodes;
+  if (type.family == ElementFamily::pyramid) {
+    // W's columns are polynomials in the cube coordinates (u, v, t) (pyramid_space.hpp):
+    // one tensor space of degree r per axis, subdivided like a hexahedron's.
+    init_w_space({1, 1, 1}, type.order);
+    init_pyramid_derivatives();
+    return;
+  }
+  const auto shapes = factor_shapes(type.family);
+  QV_ASSERT(!shapes.empty(), "no mu space for " << type.name);
+  const int p = type.order;
+  const auto nf = static_cast<int>(shapes.size());
+  const bool simplex = simplicial(type.family);
+  {
+    std::vector<int> dims;
+    for (const FactorShape& s : shapes) dims.push_back(s.dim);
+    init_w_space(dims, simplex ? p - 1 : p);
+  }
 
   // Lattice of the geometry (degree p per factor) and its points' keys.
   std::vector<std::vector<MultiIndex>> geo(static_cast<std::size_t>(nf));

@@ -19,13 +19,14 @@ namespace quadval {
 /// Highest order of each family whose metric polynomials are bounded (the degree-12n
 /// certificate of 3D elements grows as (12 n)^3 coefficients and its products as the
 /// square of the degree-6n spaces): triangles and quadrangles 6, tetrahedra 3, prisms and
-/// hexahedra 2; lines 10 (mu is 1 or 0); 0 for pyramids and other families.
+/// hexahedra 2, pyramids 2 (W in the cube coordinates, degree r per factor like a
+/// hexahedron's); lines 10 (mu is 1 or 0); 0 for other families.
 int mu_max_order(ElementFamily family) noexcept;
 
 class MuSpace {
  public:
-  /// @pre type a Lagrange triangle, quadrangle, tetrahedron, prism or hexahedron of order
-  ///      1..mu_max_order(family)
+  /// @pre type a Lagrange triangle, quadrangle, tetrahedron, prism, hexahedron or pyramid
+  ///      of order 1..mu_max_order(family)
   explicit MuSpace(const ElementType& type);
 
   const ElementType& type() const noexcept { return *type_; }
@@ -33,14 +34,17 @@ class MuSpace {
   int num_nodes() const noexcept { return num_nodes_; }
 
   /// The space of the entries of W: degree n per factor (simplices p - 1; quadrangles,
-  /// prisms, hexahedra p in every factor, the derivative factor degree-elevated).
+  /// prisms, hexahedra p in every factor, the derivative factor degree-elevated; pyramids
+  /// r in each of the cube coordinates (u, v, t) of bezier/pyramid_basis.hpp, every
+  /// column degree-elevated from pyramid_derivative_degrees to (r, r, r)).
   const BezierBasis& w_basis() const noexcept { return *w_basis_; }
   int w_size() const noexcept { return w_basis_->size(); }
   /// Degrees m n per factor, m in {1, 2, 4, 6, 8, 12} (3D; 2D: 1, 2, 4).
   const std::vector<FactorDegree>& degrees(int m) const noexcept { return degrees_[m]; }
   int size(int m) const noexcept { return sizes_[m]; }
 
-  /// Control value k of dX/dxi_c (Gmsh reference coordinates) = sum_i
+  /// Control value k of dX/dxi_c (Gmsh reference coordinates; pyramids: as a polynomial
+  /// in the cube coordinates, analysis/pyramid_space.hpp) = sum_i
   /// derivative(c)[k * num_nodes + i] * (x_i - x_0); entries within 2u of the exact
   /// rationals (relative). c < dim().
   const std::vector<double>& derivative(int c) const noexcept { return deriv_[c]; }
@@ -56,6 +60,12 @@ class MuSpace {
   const BernsteinProduct& prod(int a, int b) const;
 
  private:
+  // The W space (simplex factors of these dimensions, degree n each), its product tables
+  // and the ideal element.
+  void init_w_space(const std::vector<int>& factor_dims, int n);
+  // Pyramids: derivative maps from Bergot's exact shape functions (pyramid_space.hpp).
+  void init_pyramid_derivatives();
+
   const ElementType* type_;
   int dim_ = 0;
   int num_nodes_ = 0;
@@ -67,6 +77,20 @@ class MuSpace {
   std::array<double, 9> ideal_inv_{};
   std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> prod_;
 };
+
+/// Pyramids: the exact maps from the nodes to the Bézier control values of the columns
+/// X_xi, X_eta, X_zeta of J_p (Gmsh's directions) as polynomials in the cube coordinates
+/// (u, v, t) (analysis/pyramid_space.hpp), every column degree-elevated from
+/// pyramid_derivative_degrees(r, c) to (r, r, r): control value k (index
+/// k0 + (r+1) (k1 + (r+1) k2)) of column c = sum_i map[c][k * #nodes + i] (x_i - x_0),
+/// each entry the double nearest to the exact rational; row_sum[c] >= max_k sum_i of the
+/// exact |entries|. Shared by mu (MuSpace) and the scaled Jacobian.
+/// @pre type is a Lagrange pyramid
+struct PyramidColumnMaps {
+  std::array<std::vector<double>, 3> map;
+  std::array<double, 3> row_sum{};
+};
+PyramidColumnMaps pyramid_column_maps(const ElementType& type);
 
 /// The shared space of `type`; thread-safe, built once.
 const MuSpace& mu_space(const ElementType& type);

@@ -9,6 +9,7 @@
 #include <memory>
 #include <mutex>
 
+#include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "quadval/error.hpp"
@@ -19,9 +20,17 @@ namespace {
 
 constexpr double kUnit = 0x1p-53;
 
+// The degrees of J as the products below form it: the Jacobian space's, except pyramids,
+// whose columns are all taken in the cube space of degree r per axis
+// (pyramid_column_maps), so J = c_1 . (c_2 x c_3) has degree 3r per axis.
+std::vector<FactorDegree> j_degrees_of(const ElementType& type) {
+  if (type.family == ElementFamily::pyramid) return std::vector<FactorDegree>(3, {1, 3 * type.order});
+  return jacobian_factor_degrees(type.family, type.order);
+}
+
 std::vector<const BernsteinSimplex*> squared_factors(const ElementType& type) {
   std::vector<const BernsteinSimplex*> out;
-  for (const FactorDegree& fd : jacobian_factor_degrees(type.family, type.order))
+  for (const FactorDegree& fd : j_degrees_of(type))
     out.push_back(&bernstein_simplex(fd.dim, 2 * fd.degree));
   return out;
 }
@@ -59,6 +68,27 @@ std::vector<Frame> simplex_corner_frames(int d) {
   return frames;
 }
 
+// Base-corner frames of Gmsh's reference pyramid: at base vertex k, the half base edges
+// to the next and the previous base vertex and the edge to the apex (entries in
+// {-1, 0, 1}, det +-1), the first two swapped when that makes det E_k = 1.
+std::vector<Frame> pyramid_corner_frames() {
+  const int base[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  std::vector<Frame> frames;
+  for (int k = 0; k < 4; ++k) {
+    const int* v = base[k];
+    const int* next = base[(k + 1) % 4];
+    const int* prev = base[(k + 3) % 4];
+    Frame f{};
+    f[0] = {(next[0] - v[0]) / 2, (next[1] - v[1]) / 2, 0};
+    f[1] = {(prev[0] - v[0]) / 2, (prev[1] - v[1]) / 2, 0};
+    f[2] = {-v[0], -v[1], 1};
+    if (det3(f) < 0) std::swap(f[0], f[1]);
+    QV_ASSERT(det3(f) == 1, "pyramid frame " << k);
+    frames.push_back(f);
+  }
+  return frames;
+}
+
 std::vector<Frame> family_frames(ElementFamily f) {
   const Frame identity{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
   switch (f) {
@@ -69,6 +99,7 @@ std::vector<Frame> family_frames(ElementFamily f) {
       for (Frame& fr : frames) fr[2] = {0, 0, 1};  // times the axis
       return frames;
     }
+    case ElementFamily::pyramid: return pyramid_corner_frames();
     default: return {identity};
   }
 }
@@ -83,12 +114,13 @@ int scaled_jacobian_max_order(ElementFamily family) noexcept {
     case ElementFamily::tetrahedron:
     case ElementFamily::prism:
     case ElementFamily::hexahedron: return 3;
+    case ElementFamily::pyramid: return 2;
     default: return 0;
   }
 }
 
 bool scaled_jacobian_supported(const ElementType& type) noexcept {
-  return type.family != ElementFamily::pyramid && jacobian_supported(type) &&
+  return jacobian_supported(type) &&
          type.order <= scaled_jacobian_max_order(type.family);
 }
 
@@ -150,11 +182,15 @@ Matrix multiply(const Matrix& a, const Matrix& b, std::size_t rows, std::size_t 
 
 ScaledJacobianSpace::ScaledJacobianSpace(const ElementType& type)
     : type_(&type),
-      j_degrees_(jacobian_factor_degrees(type.family, type.order)),
+      j_degrees_(j_degrees_of(type)),
       squared_(type.family, type.order, squared_factors(type)),
       frames_(family_frames(type.family)) {
   QV_ASSERT(scaled_jacobian_supported(type), "no scaled Jacobian for " << type.name);
   for (const FactorDegree& fd : j_degrees_) squared_degrees_.push_back({fd.dim, 2 * fd.degree});
+  if (type.family == ElementFamily::pyramid) {
+    init_pyramid();
+    return;
+  }
   const JacobianSpace& js = jacobian_space(type);
   const auto nn = static_cast<std::size_t>(type.num_nodes);
   const std::size_t nf = j_degrees_.size();
@@ -228,6 +264,22 @@ ScaledJacobianSpace::ScaledJacobianSpace(const ElementType& type)
   // Two roundings (sqrt, division): two ulps each way enclose the exact value.
   s_lo_ = s == 1 ? 1 : next_down(next_down(s));
   s_hi_ = s == 1 ? 1 : next_up(next_up(s));
+}
+
+void ScaledJacobianSpace::init_pyramid() {
+  // Columns in the cube coordinates (pyramid_space.hpp), degree r per axis; entries within
+  // u of the exact rationals (the map's rows sum to zero, as for the other families).
+  PyramidColumnMaps maps = pyramid_column_maps(*type_);
+  const int r = type_->order;
+  for (std::size_t c = 0; c < 3; ++c) {
+    col_degrees_[c] = std::vector<FactorDegree>(3, {1, r});
+    col_size_[c] = (r + 1) * (r + 1) * (r + 1);
+    col_map_[c] = std::move(maps.map[c]);
+    col_row_sum_[c] = next_up(maps.row_sum[c]);
+  }
+  // At the ideal pyramid each corner frame has |V| / prod |v_j| = 1 / sqrt 2.
+  s_lo_ = next_down(next_down(std::sqrt(2.0)));
+  s_hi_ = next_up(next_up(std::sqrt(2.0)));
 }
 
 const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type) {

@@ -36,7 +36,9 @@ class ScaledJacobianSpace {
   double s_hi() const noexcept { return s_hi_; }
 
   /// Column c = dX/dxi_c (Gmsh coordinates) lies in the tensor space column_degrees(c):
-  /// the geometry's degree p per factor, p - 1 in the factor holding direction c.
+  /// the geometry's degree p per factor, p - 1 in the factor holding direction c;
+  /// pyramids: degree r in each cube coordinate (u, v, t) (mu_space.hpp,
+  /// pyramid_column_maps), J then of degree 3r per axis.
   const std::vector<FactorDegree>& column_degrees(int c) const noexcept { return col_degrees_[static_cast<std::size_t>(c)]; }
   int column_size(int c) const noexcept { return col_size_[static_cast<std::size_t>(c)]; }
   /// Its Bézier coefficients = column_map(c) * (x_i - x_0) per axis: row-major
@@ -47,6 +49,8 @@ class ScaledJacobianSpace {
   double column_row_sum(int c) const noexcept { return col_row_sum_[static_cast<std::size_t>(c)]; }
 
  private:
+  void init_pyramid();
+
   const ElementType* type_;
   std::vector<FactorDegree> j_degrees_, squared_degrees_;
   BezierBasis squared_;

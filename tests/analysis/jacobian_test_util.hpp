@@ -104,6 +104,9 @@ inline std::vector<RefPoint> dense_points(ElementFamily f, int m, int random_cou
       case ElementFamily::tetrahedron: if (a + b + c <= 1) pts.push_back({a, b, c}); break;
       case ElementFamily::prism: if (a + b <= 1) pts.push_back({a, b, 2 * c - 1}); break;
       case ElementFamily::hexahedron: pts.push_back({2 * a - 1, 2 * b - 1, 2 * c - 1}); break;
+      case ElementFamily::pyramid:  // cube coordinates (a, b, t = 1 - c); never the apex
+        if (c < 1) pts.push_back({(2 * a - 1) * (1 - c), (2 * b - 1) * (1 - c), c});
+        break;
       default: break;
     }
   };

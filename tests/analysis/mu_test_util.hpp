@@ -25,6 +25,8 @@ inline std::vector<Eigen::Vector3d> ideal_vertices(ElementFamily f) {
       return {{0, 0, 0}, {1, 0, 0}, {0.5, h, 0}, {0, 0, 1}, {1, 0, 1}, {0.5, h, 1}};
     case ElementFamily::hexahedron:
       return {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    case ElementFamily::pyramid:  // unit square base, equilateral triangular faces
+      return {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0.5, 0.5, 1 / std::sqrt(2.0)}};
     default: return {};
   }
 }
@@ -43,6 +45,8 @@ inline Eigen::MatrixXd ideal_jacobian(ElementFamily f) {
     case ElementFamily::hexahedron:
       col(0, (v[1] - v[0]) / 2); col(1, (v[3] - v[0]) / 2); col(2, (v[4] - v[0]) / 2); break;
     case ElementFamily::prism: col(0, v[1] - v[0]); col(1, v[2] - v[0]); col(2, (v[3] - v[0]) / 2); break;
+    case ElementFamily::pyramid:  // zeta runs from the base centre to the apex
+      col(0, (v[1] - v[0]) / 2); col(1, (v[3] - v[0]) / 2); col(2, v[4] - (v[0] + v[1] + v[2] + v[3]) / 4); break;
     default: break;
   }
   return j;

@@ -5,6 +5,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/mu_bernstein_product_test.cpp
   analysis/mu_constant_test.cpp
   analysis/mu_control_bound_test.cpp
+  analysis/pyramid_quality_test.cpp
   analysis/jacobian_bounds_test.cpp
   analysis/jacobian_exact_test.cpp
   analysis/gmsh_agreement_test.cpp
