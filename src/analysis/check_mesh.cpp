@@ -483,11 +483,16 @@ std::size_t CheckReport::skipped() const {
   return n;
 }
 
-std::vector<std::size_t> CheckReport::worst_quality(std::size_t n, bool sj) const {
+namespace {
+
+// The indices of the n elements with the smallest keys among those `included`; ties by tag,
+// then by index.
+template <class Key, class Included>
+std::vector<std::size_t> smallest(const std::vector<ElementCheck>& elements, std::size_t n,
+                                  Key key, Included included) {
   std::vector<std::size_t> idx;
-  const auto key = [&](std::size_t i) { return (sj ? sj_of(i) : mu_of(i)).lower; };
   for (std::size_t i = 0; i < elements.size(); ++i)
-    if (!std::isnan(key(i))) idx.push_back(i);
+    if (included(i)) idx.push_back(i);
   const std::size_t m = std::min(n, idx.size());
   std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m), idx.end(),
                     [&](std::size_t a, std::size_t b) {
@@ -499,25 +504,20 @@ std::vector<std::size_t> CheckReport::worst_quality(std::size_t n, bool sj) cons
   return idx;
 }
 
+}  // namespace
+
+std::vector<std::size_t> CheckReport::worst_quality(std::size_t n, bool sj) const {
+  const auto key = [&](std::size_t i) { return (sj ? sj_of(i) : mu_of(i)).lower; };
+  return smallest(elements, n, key, [&](std::size_t i) { return !std::isnan(key(i)); });
+}
+
 std::vector<std::size_t> CheckReport::worst(std::size_t n) const {
-  std::vector<std::size_t> idx;
   const bool by_distortion = measures_distortion(measure);
   const auto key = [&](std::size_t i) {
-    const ElementCheck& e = elements[i];
-    const double k = by_distortion ? distortion_of(i).lower : e.ratio_lower();
+    const double k = by_distortion ? distortion_of(i).lower : elements[i].ratio_lower();
     return std::isnan(k) ? -INFINITY : k;
   };
-  for (std::size_t i = 0; i < elements.size(); ++i)
-    if (elements[i].analysed) idx.push_back(i);
-  const std::size_t m = std::min(n, idx.size());
-  std::partial_sort(idx.begin(), idx.begin() + static_cast<std::ptrdiff_t>(m), idx.end(),
-                    [&](std::size_t a, std::size_t b) {
-                      const double ka = key(a), kb = key(b);
-                      if (ka != kb) return ka < kb;
-                      return elements[a].tag != elements[b].tag ? elements[a].tag < elements[b].tag : a < b;
-                    });
-  idx.resize(m);
-  return idx;
+  return smallest(elements, n, key, [&](std::size_t i) { return elements[i].analysed; });
 }
 
 }  // namespace quadval
