@@ -793,13 +793,76 @@ class Solver {
   EventQueue grow_queue_, shrink_queue_, expand_queue_;
 };
 
+// The graph renumbered breadth first (vertices in the order a BFS from the lowest unvisited
+// vertex reaches them; edges by their lower new endpoint), so that the vertices a tree grows
+// over, and their edges, sit close together in memory. The solver is bound by memory latency:
+// measured on square-hole-100k/300k (same events, same matching), 1.7 -> 1.1 s and
+// 7.7 -> 5.2 s. The greedy start, which visits vertices in index order, also leaves fewer
+// vertices free in this order (uniform-100k: 4,238 -> 1,312; 20.8 -> 7.9 s).
+struct LocalGraph {
+  std::vector<CostEdge> edges;           // renumbered
+  std::vector<std::uint32_t> edge_from;  // original index of each renumbered edge
+};
+LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges) {
+  std::vector<std::uint32_t> offsets(std::size_t{n} + 1, 0), adjacent(2 * edges.size());
+  for (const CostEdge& e : edges) {
+    ++offsets[e.u + 1];
+    ++offsets[e.v + 1];
+  }
+  for (std::uint32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+  {
+    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+    for (const CostEdge& e : edges) {
+      adjacent[fill[e.u]++] = e.v;
+      adjacent[fill[e.v]++] = e.u;
+    }
+  }
+  constexpr std::uint32_t kUnseen = 0xffffffffu;
+  std::vector<std::uint32_t> new_id(n, kUnseen), queue;
+  queue.reserve(n);
+  for (std::uint32_t s = 0; s < n; ++s) {
+    if (new_id[s] != kUnseen) continue;
+    new_id[s] = static_cast<std::uint32_t>(queue.size());
+    queue.push_back(s);
+    for (std::size_t head = queue.size() - 1; head < queue.size(); ++head)
+      for (std::uint32_t i = offsets[queue[head]]; i < offsets[queue[head] + 1]; ++i)
+        if (new_id[adjacent[i]] == kUnseen) {
+          new_id[adjacent[i]] = static_cast<std::uint32_t>(queue.size());
+          queue.push_back(adjacent[i]);
+        }
+  }
+  // Edges bucketed by their lower new endpoint (a counting sort, stable).
+  std::fill(offsets.begin(), offsets.end(), 0);
+  for (const CostEdge& e : edges) ++offsets[std::min(new_id[e.u], new_id[e.v]) + 1];
+  for (std::uint32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
+  LocalGraph g;
+  g.edges.resize(edges.size());
+  g.edge_from.resize(edges.size());
+  for (std::uint32_t i = 0; i < edges.size(); ++i) {
+    const CostEdge& e = edges[i];
+    const std::uint32_t k = offsets[std::min(new_id[e.u], new_id[e.v])]++;
+    g.edges[k] = {new_id[e.u], new_id[e.v], e.cost};
+    g.edge_from[k] = i;
+  }
+  return g;
+}
+
 }  // namespace
 
 bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
                                std::vector<char>& matched, const MatchingProgress& progress) {
-  Solver solver(num_nodes, edges, progress);
+  for (std::size_t e = 0; e < edges.size(); ++e)
+    QV_ASSERT(edges[e].u < num_nodes && edges[e].v < num_nodes && edges[e].u != edges[e].v,
+              "edge " << e << " (" << edges[e].u << ", " << edges[e].v << ") in a graph of "
+                      << num_nodes);
+  const LocalGraph local = breadth_first_order(num_nodes, edges);
+  Solver solver(num_nodes, local.edges, progress);
   if (!solver.run()) return false;
-  solver.read(matched);
+  std::vector<char> local_matched;
+  solver.read(local_matched);
+  matched.assign(edges.size(), 0);
+  for (std::size_t k = 0; k < local_matched.size(); ++k)
+    matched[local.edge_from[k]] = local_matched[k];
   return true;
 }
 
