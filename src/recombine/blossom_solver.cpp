@@ -796,9 +796,10 @@ class Solver {
 // The graph renumbered breadth first (vertices in the order a BFS from the lowest unvisited
 // vertex reaches them; edges by their lower new endpoint), so that the vertices a tree grows
 // over, and their edges, sit close together in memory. The solver is bound by memory latency:
-// measured on square-hole-100k/300k (same events, same matching), 1.7 -> 1.1 s and
-// 7.7 -> 5.2 s. The greedy start, which visits vertices in index order, also leaves fewer
-// vertices free in this order (uniform-100k: 4,238 -> 1,312; 20.8 -> 7.9 s).
+// on square-hole-100k/300k (nearly the same events and the same matching) CPU time went
+// 0.83 -> 0.65 s and 4.05 -> 3.21 s (medians of 3). The greedy start, which visits vertices in
+// index order, also leaves fewer vertices free in this order (uniform-100k: 4,238 -> 1,312
+// free, 8.9 -> 4.5 s).
 struct LocalGraph {
   std::vector<CostEdge> edges;           // renumbered
   std::vector<std::uint32_t> edge_from;  // original index of each renumbered edge
