@@ -2,120 +2,267 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
 
 namespace quadval::recombine_detail {
 
-std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options) {
-  if (options.passes <= 0) return 0;
-  // Static CSR node -> elements: the topology does not change here.
+double smoothing_score(const std::vector<double>& coords, const std::array<NodeIndex, 4>& element,
+                       const std::array<double, 3>& normal, double normal_length) noexcept {
+  if (element[3] == kNoNode) return -2.0;  // not a quad: callers use element_score
+  if (normal_length == 0.0) return -1.0;   // quad_eta: degenerate; corner sine: -1
+  // The operations of quad_eta and quad_min_corner_sine, in their order, so the value is the
+  // same to the bit; but each edge and its length once (corner k's backward edge is exactly
+  // minus edge k-1), not twice.
+  double edge[4][3], length[4];
+  for (int k = 0; k < 4; ++k) {
+    const double* p = coords.data() + 3 * std::size_t{element[k]};
+    const double* q = coords.data() + 3 * std::size_t{element[(k + 1) % 4]};
+    for (int d = 0; d < 3; ++d) edge[k][d] = q[d] - p[d];
+    length[k] =
+        std::sqrt(edge[k][0] * edge[k][0] + edge[k][1] * edge[k][1] + edge[k][2] * edge[k][2]);
+  }
+  bool valid = true;
+  double turn[4], lengths[4], cosine[4];  // per corner
+  for (int k = 0; k < 4; ++k) {
+    const double* f = edge[k];
+    const double b[3] = {-edge[(k + 3) % 4][0], -edge[(k + 3) % 4][1], -edge[(k + 3) % 4][2]};
+    lengths[k] = length[k] * length[(k + 3) % 4];
+    const double cr[3] = {f[1] * b[2] - f[2] * b[1], f[2] * b[0] - f[0] * b[2],
+                          f[0] * b[1] - f[1] * b[0]};
+    turn[k] = cr[0] * normal[0] + cr[1] * normal[1] + cr[2] * normal[2];
+    cosine[k] = std::abs(f[0] * b[0] + f[1] * b[1] + f[2] * b[2]);
+    if (lengths[k] == 0.0 || turn[k] <= 0.0) valid = false;  // degenerate, reflex or inverted
+  }
+  if (valid) {
+    double worst_cos = 0.0;
+    for (int k = 0; k < 4; ++k) worst_cos = std::max(worst_cos, cosine[k] / lengths[k]);
+    // eta (eq. 3): the worst corner deviates from pi/2 by asin(|cos|).
+    const double worst_deviation = std::asin(std::min(worst_cos, 1.0));
+    const double eta = std::max(1.0 - worst_deviation / (std::numbers::pi / 2), 0.0);
+    if (eta > 0.0) return eta;
+  }
+  double worst_sine = 1.0;
+  for (int k = 0; k < 4; ++k) {
+    const double scale = lengths[k] * normal_length;
+    if (scale == 0.0) return -1.0;
+    worst_sine = std::min(worst_sine, turn[k] / scale);
+  }
+  return std::min(worst_sine, 0.0);
+}
+
+namespace {
+
+bool can_slide(NodeIndex v, const std::vector<char>& fixed, const SmoothingOptions& options) {
+  return fixed[v] && options.slides != nullptr && (*options.slides)[v][0] != kNoNode;
+}
+
+/// Everything smooth() needs that the moves do not change (the topology is fixed here): per
+/// node its alive elements and, per element, its two edge neighbours there; the movable nodes
+/// in node order (the sweep order).
+struct SmoothingTopology {
+  std::vector<std::uint32_t> star_offsets;             ///< #nodes + 1
+  std::vector<std::uint32_t> star;                     ///< local ids of the elements at each node
+  std::vector<std::array<NodeIndex, 2>> star_sides;    ///< per star entry: next, prev corner
+  std::vector<NodeIndex> order;                        ///< movable nodes, ascending
+  /// Local id -> element of m: the alive elements in the order the sweep first meets them,
+  /// so that a sweep reads their data nearly in memory order (m's order, after matching and
+  /// repair, scatters them: cache misses).
+  std::vector<std::uint32_t> element_of;
+};
+
+SmoothingTopology build_topology(const MixedMesh& m, const std::vector<char>& fixed,
+                                 const SmoothingOptions& options) {
+  SmoothingTopology t;
   const std::size_t n = m.num_nodes();
-  std::vector<std::uint32_t> offsets(n + 1, 0);
+  t.star_offsets.assign(n + 1, 0);
   for (std::size_t e = 0; e < m.elements.size(); ++e)
     if (m.alive[e])
-      for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i) ++offsets[m.elements[e][i] + 1];
-  for (std::size_t i = 0; i < n; ++i) offsets[i + 1] += offsets[i];
-  std::vector<std::uint32_t> incident(offsets[n]);
-  {
-    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (std::size_t e = 0; e < m.elements.size(); ++e)
-      if (m.alive[e])
-        for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i)
-          incident[fill[m.elements[e][i]]++] = static_cast<std::uint32_t>(e);
+      for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i)
+        ++t.star_offsets[m.elements[e][i] + 1];
+  for (std::size_t i = 0; i < n; ++i) t.star_offsets[i + 1] += t.star_offsets[i];
+  t.star.resize(t.star_offsets[n]);
+  t.star_sides.resize(t.star_offsets[n]);
+  std::vector<std::uint32_t> fill(t.star_offsets.begin(), t.star_offsets.end() - 1);
+  for (std::size_t e = 0; e < m.elements.size(); ++e) {
+    if (!m.alive[e]) continue;
+    const auto& el = m.elements[e];
+    for (int i = 0; i < MixedMesh::size(el); ++i) {
+      const std::uint32_t k = fill[el[i]]++;
+      t.star[k] = static_cast<std::uint32_t>(e);
+      t.star_sides[k] = {next_corner(el, i), prev_corner(el, i)};
+    }
   }
-  std::vector<double> score(m.elements.size(), 0.0);
-  for (std::size_t e = 0; e < m.elements.size(); ++e)
-    if (m.alive[e]) score[e] = element_score(m, e);
 
+  for (NodeIndex v = 0; v < n; ++v)
+    if ((!fixed[v] || can_slide(v, fixed, options)) && t.star_offsets[v] < t.star_offsets[v + 1])
+      t.order.push_back(v);
+
+  constexpr std::uint32_t kUnset = 0xffffffffu;
+  std::vector<std::uint32_t> local(m.elements.size(), kUnset);
+  auto number = [&](std::uint32_t e) {
+    if (local[e] != kUnset) return;
+    local[e] = static_cast<std::uint32_t>(t.element_of.size());
+    t.element_of.push_back(e);
+  };
+  for (NodeIndex v : t.order)
+    for (std::uint32_t i = t.star_offsets[v]; i < t.star_offsets[v + 1]; ++i) number(t.star[i]);
+  for (std::size_t e = 0; e < m.elements.size(); ++e)  // those with no movable corner
+    if (m.alive[e]) number(static_cast<std::uint32_t>(e));
+  for (std::uint32_t& e : t.star) e = local[e];
+  return t;
+}
+
+/// One smooth() call: the topology, the score of each element (cached, updated on each
+/// accepted move) and the trial of one node.
+class Smoother {
+ public:
+  Smoother(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options)
+      : m_(m), fixed_(fixed), options_(options), topo_(build_topology(m, fixed, options)) {
+    const std::size_t count = topo_.element_of.size();
+    elements_.resize(count);
+    normals_.resize(count);
+    normal_length_.resize(count);
+    score_.resize(count);
+    for (std::size_t l = 0; l < count; ++l) {
+      const std::uint32_t e = topo_.element_of[l];
+      elements_[l] = m.elements[e];
+      normals_[l] = m.normal[e];
+      const auto& nv = normals_[l];
+      normal_length_[l] = std::sqrt(nv[0] * nv[0] + nv[1] * nv[1] + nv[2] * nv[2]);
+      score_[l] = score(static_cast<std::uint32_t>(l));
+    }
+  }
+
+  std::size_t run();
+
+ private:
+  // element_score of local element l; for quads through smoothing_score (the same value).
+  double score(std::uint32_t l) const noexcept {
+    return elements_[l][3] != kNoNode
+               ? smoothing_score(m_.coords, elements_[l], normals_[l], normal_length_[l])
+               : element_score(m_, topo_.element_of[l]);
+  }
+  bool try_move(NodeIndex v, bool raise_mean, double global_min, std::vector<double>& trial);
+
+  MixedMesh& m_;
+  const std::vector<char>& fixed_;
+  const SmoothingOptions& options_;
+  SmoothingTopology topo_;
+  // Per local element (topo_.element_of): copies of its corners and normal, |normal|, score.
+  std::vector<std::array<NodeIndex, 4>> elements_;
+  std::vector<std::array<double, 3>> normals_;
+  std::vector<double> normal_length_;
+  std::vector<double> score_;
+};
+
+bool Smoother::try_move(NodeIndex v, bool raise_mean, double global_min,
+                        std::vector<double>& trial) {
+  const std::uint32_t first = topo_.star_offsets[v], last = topo_.star_offsets[v + 1];
+  const bool sliding = fixed_[v] != 0;  // only the sliding fixed nodes are in the order
+  const std::array<double, 3> x = m_.point(v);
+  double sum[3] = {0, 0, 0}, weights = 0, old_min = 2.0, old_sum = 0.0;
+  std::array<double, 3> normal{0, 0, 0};
+  for (std::uint32_t i = first; i < last; ++i) {
+    const std::uint32_t e = topo_.star[i];
+    old_min = std::min(old_min, score_[e]);
+    old_sum += score_[e];
+    if (options_.tangential)
+      for (int d = 0; d < 3; ++d) normal[d] += normals_[e][d];
+    // Each edge neighbour appears in two elements at an interior node: each counts once
+    // per element, which weighs them equally.
+    for (NodeIndex j : topo_.star_sides[i]) {
+      const double* y = m_.coords.data() + 3 * std::size_t{j};
+      double w = 1.0;
+      if (options_.size_field != nullptr) {
+        const double h = (*options_.size_field)(0.5 * (x[0] + y[0]), 0.5 * (x[1] + y[1]),
+                                                0.5 * (x[2] + y[2]));
+        w = h > 0 && std::isfinite(h) ? 1.0 / h : 1.0;
+      }
+      for (int d = 0; d < 3; ++d) sum[d] += w * y[d];
+      weights += w;
+    }
+  }
+  std::array<double, 3> move{sum[0] / weights - x[0], sum[1] / weights - x[1],
+                             sum[2] / weights - x[2]};
+  std::array<double, 3> a{}, along{};
+  if (sliding) {
+    // Keep only the component along the side a-b.
+    a = m_.point((*options_.slides)[v][0]);
+    const auto b = m_.point((*options_.slides)[v][1]);
+    along = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const double ll = along[0] * along[0] + along[1] * along[1] + along[2] * along[2];
+    const double t = (move[0] * along[0] + move[1] * along[1] + move[2] * along[2]) / ll;
+    for (int d = 0; d < 3; ++d) move[d] = t * along[d];
+  } else if (options_.tangential) {
+    const double nn = normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2];
+    if (nn > 0) {
+      const double h = (move[0] * normal[0] + move[1] * normal[1] + move[2] * normal[2]) / nn;
+      for (int d = 0; d < 3; ++d) move[d] -= h * normal[d];
+    }
+  }
+  double* position = m_.coords.data() + 3 * std::size_t{v};
+  for (double fraction : {1.0, 0.5}) {
+    if (sliding) {
+      // Strictly between a and b (s in (0, 1) along a-b), so the side keeps its order.
+      double s = 0, ll = 0;
+      for (int d = 0; d < 3; ++d) {
+        s += (x[d] + fraction * move[d] - a[d]) * along[d];
+        ll += along[d] * along[d];
+      }
+      if (!(s > 0 && s < ll)) continue;
+    }
+    for (int d = 0; d < 3; ++d) position[d] = x[d] + fraction * move[d];
+    // Phase 1: never lower the worst element at v. Phase 2: also take moves that raise the
+    // sum of the scores at v while keeping them above the mesh's worst at the sweep's start.
+    // A score below old_min that also fails phase 2's floor refuses the move at once.
+    const double floor =
+        raise_mean ? std::max(global_min, std::numeric_limits<double>::denorm_min()) : 2.0;
+    trial.clear();
+    double new_min = 2.0, new_sum = 0;
+    bool refused = false;
+    for (std::uint32_t i = first; i < last; ++i) {
+      const double s = score(topo_.star[i]);
+      if (s < old_min && s < floor) {
+        refused = true;
+        break;
+      }
+      trial.push_back(s);
+      new_min = std::min(new_min, s);
+      new_sum += s;
+    }
+    if (!refused && (new_min >= old_min || (raise_mean && new_min >= global_min &&
+                                            new_min > 0 && new_sum > old_sum))) {
+      for (std::uint32_t i = first; i < last; ++i) score_[topo_.star[i]] = trial[i - first];
+      return true;
+    }
+    for (int d = 0; d < 3; ++d) position[d] = x[d];
+  }
+  return false;
+}
+
+std::size_t Smoother::run() {
   std::size_t accepted = 0;
   std::vector<double> trial;
-  for (int pass = 0; pass < 2 * options.passes; ++pass) {
-    const bool raise_mean = pass >= options.passes;
-    std::size_t accepted_this_pass = 0;
+  for (int pass = 0; pass < 2 * options_.passes; ++pass) {
+    const bool raise_mean = pass >= options_.passes;
     double global_min = 2.0;
-    for (std::size_t e = 0; e < m.elements.size(); ++e)
-      if (m.alive[e]) global_min = std::min(global_min, score[e]);
-    for (NodeIndex v = 0; v < n; ++v) {
-      const bool sliding =
-          fixed[v] && options.slides != nullptr && (*options.slides)[v][0] != kNoNode;
-      if ((fixed[v] && !sliding) || offsets[v] == offsets[v + 1]) continue;
-      const std::array<double, 3> x = m.point(v);
-      double sum[3] = {0, 0, 0}, weights = 0;
-      std::array<double, 3> normal{0, 0, 0};
-      double old_min = 2.0;
-      for (std::uint32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
-        const std::uint32_t e = incident[i];
-        old_min = std::min(old_min, score[e]);
-        for (int d = 0; d < 3; ++d) normal[d] += m.normal[e][d];
-        const auto& el = m.elements[e];
-        const int c = corner_of(el, v);
-        // Each edge neighbour appears in two elements at an interior node: each counts once
-        // per element, which weighs them equally.
-        for (NodeIndex j : {next_corner(el, c), prev_corner(el, c)}) {
-          const auto y = m.point(j);
-          double w = 1.0;
-          if (options.size_field != nullptr) {
-            const double h = (*options.size_field)(0.5 * (x[0] + y[0]), 0.5 * (x[1] + y[1]),
-                                                   0.5 * (x[2] + y[2]));
-            w = h > 0 && std::isfinite(h) ? 1.0 / h : 1.0;
-          }
-          for (int d = 0; d < 3; ++d) sum[d] += w * y[d];
-          weights += w;
-        }
-      }
-      std::array<double, 3> move{sum[0] / weights - x[0], sum[1] / weights - x[1],
-                                 sum[2] / weights - x[2]};
-      std::array<double, 3> a{}, along{};
-      if (sliding) {
-        // Keep only the component along the side a-b.
-        a = m.point((*options.slides)[v][0]);
-        const auto b = m.point((*options.slides)[v][1]);
-        along = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
-        const double ll = along[0] * along[0] + along[1] * along[1] + along[2] * along[2];
-        const double t = (move[0] * along[0] + move[1] * along[1] + move[2] * along[2]) / ll;
-        for (int d = 0; d < 3; ++d) move[d] = t * along[d];
-      } else if (options.tangential) {
-        const double nn = normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2];
-        if (nn > 0) {
-          const double h = (move[0] * normal[0] + move[1] * normal[1] + move[2] * normal[2]) / nn;
-          for (int d = 0; d < 3; ++d) move[d] -= h * normal[d];
-        }
-      }
-      for (double fraction : {1.0, 0.5}) {
-        if (sliding) {
-          // Strictly between a and b (s in (0, 1) along a-b), so the side keeps its order.
-          double s = 0, ll = 0;
-          for (int d = 0; d < 3; ++d) {
-            s += (x[d] + fraction * move[d] - a[d]) * along[d];
-            ll += along[d] * along[d];
-          }
-          if (!(s > 0 && s < ll)) continue;
-        }
-        for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d] + fraction * move[d];
-        trial.clear();
-        double new_min = 2.0, new_sum = 0, old_sum = 0;
-        for (std::uint32_t i = offsets[v]; i < offsets[v + 1]; ++i) {
-          trial.push_back(element_score(m, incident[i]));
-          new_min = std::min(new_min, trial.back());
-          new_sum += trial.back();
-          old_sum += score[incident[i]];
-        }
-        // Phase 1: never lower the worst element at v. Phase 2: also take moves that raise
-        // the sum of the scores at v while keeping them above the mesh's current worst.
-        const bool ok = new_min >= old_min ||
-                        (raise_mean && new_min >= global_min && new_min > 0 && new_sum > old_sum);
-        if (ok) {
-          for (std::uint32_t i = offsets[v]; i < offsets[v + 1]; ++i)
-            score[incident[i]] = trial[i - offsets[v]];
-          ++accepted_this_pass;
-          break;
-        }
-        for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d];
-      }
-    }
+    for (double s : score_) global_min = std::min(global_min, s);
+    std::size_t accepted_this_pass = 0;
+    for (NodeIndex v : topo_.order)
+      if (try_move(v, raise_mean, global_min, trial)) ++accepted_this_pass;
     accepted += accepted_this_pass;
     if (accepted_this_pass == 0 && raise_mean) break;
   }
   return accepted;
+}
+
+}  // namespace
+
+std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options) {
+  if (options.passes <= 0) return 0;
+  return Smoother(m, fixed, options).run();
 }
 
 std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,

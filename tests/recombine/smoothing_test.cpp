@@ -1,15 +1,248 @@
-// The last polish of the worst elements (polish_worst): a closed form, one interior node
-// pulled off the centre of 2 x 2 unit squares goes back to where all four are squares.
+// Smoothing (Paper I §6). smoothing_score equals element_score bit for bit (closed forms and
+// random quads, valid, reflex, inverted, degenerate). smooth() gives, bit for bit, what the
+// plain sweep of its doc comment gives (written out here with element_score, node_elements
+// and corner_of: none of smooth()'s shortcuts), never lowers the worst score and inverts
+// nothing. The last polish of the worst elements (polish_worst): a closed form, one interior
+// node pulled off the centre of 2 x 2 unit squares goes back to where all four are squares.
 #include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <random>
 
 #include <gtest/gtest.h>
 
+#include "recombine/boundary_slide.hpp"
 #include "recombine/smoothing.hpp"
 
 namespace quadval {
 namespace {
 
 using namespace recombine_detail;
+
+double normal_length(const std::array<double, 3>& n) {
+  return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
+
+// One quad (nodes 0..3) with the given corners; the score of smoothing_score.
+double score_of(const std::array<std::array<double, 3>, 4>& x, const std::array<double, 3>& n) {
+  MixedMesh m;
+  for (int k = 0; k < 4; ++k) m.add_node(x[k], k + 1);
+  return smoothing_score(m.coords, {0, 1, 2, 3}, n, normal_length(n));
+}
+
+TEST(SmoothingScore, ClosedForms) {
+  const std::array<double, 3> up{0, 0, 1};
+  EXPECT_EQ(score_of({{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}}, up), 1.0);  // square
+  // Rhombus with 60 and 120 degree corners: each deviates 30 degrees, eta = 1 - 30/90.
+  const double h = std::sqrt(3.0) / 2;
+  EXPECT_NEAR(score_of({{{0, 0, 0}, {1, 0, 0}, {1.5, h, 0}, {0.5, h, 0}}}, up), 2.0 / 3.0, 1e-14);
+  // The square seen from below is inverted: every corner sine is -1.
+  EXPECT_EQ(score_of({{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}}, {0, 0, -1}), -1.0);
+  // A repeated corner is degenerate: -1, like element_score.
+  EXPECT_EQ(score_of({{{0, 0, 0}, {1, 0, 0}, {1, 0, 0}, {0, 1, 0}}}, up), -1.0);
+  EXPECT_EQ(score_of({{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}}, {0, 0, 0}), -1.0);
+  // A triangle is not its business.
+  MixedMesh t;
+  for (int k = 0; k < 3; ++k) t.add_node({double(k == 1), double(k == 2), 0.0}, k + 1);
+  EXPECT_EQ(smoothing_score(t.coords, {0, 1, 2, kNoNode}, up, 1.0), -2.0);
+}
+
+// Random quads around the unit square, from slightly to wildly perturbed (so convex, reflex,
+// inverted and nearly degenerate ones), with tilted and scaled normals.
+TEST(SmoothingScore, EqualsElementScoreBitForBit) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  int valid = 0, invalid = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double amplitude = 0.02 + 0.8 * (i % 10) / 9.0;
+    MixedMesh m;
+    const double corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int k = 0; k < 4; ++k)
+      m.add_node({corner[k][0] + amplitude * unit(rng), corner[k][1] + amplitude * unit(rng),
+                  amplitude * unit(rng) * (i % 3 == 0)},
+                 k + 1);
+    if (i % 97 == 0) std::memcpy(&m.coords[3], &m.coords[0], 3 * sizeof(double));  // repeat
+    const std::array<double, 3> n{0.3 * unit(rng) * (i % 2), 0.3 * unit(rng) * (i % 2),
+                                  (1.0 + 0.5 * unit(rng)) * (i % 5 == 4 ? -1.0 : 1.0)};
+    m.elements.push_back({0, 1, 2, 3});
+    m.normal.push_back(n);
+    const double want = element_score(m, 0);
+    EXPECT_EQ(smoothing_score(m.coords, m.elements[0], n, normal_length(n)), want) << "quad " << i;
+    (want > 0 ? valid : invalid)++;
+  }
+  EXPECT_GT(valid, 5000);
+  EXPECT_GT(invalid, 2000);
+}
+
+// The sweep of smooth()'s doc comment, written the plain way: every node in node order, every
+// pass, element_score of every element at the node for each trial.
+std::size_t plain_smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& o) {
+  const auto at = node_elements(m);
+  std::vector<double> score(m.elements.size(), 0.0);
+  for (std::size_t e = 0; e < m.elements.size(); ++e)
+    if (m.alive[e]) score[e] = element_score(m, e);
+  std::size_t accepted = 0;
+  for (int pass = 0; pass < 2 * o.passes; ++pass) {
+    const bool raise_mean = pass >= o.passes;
+    double global_min = 2.0;
+    for (std::size_t e = 0; e < m.elements.size(); ++e)
+      if (m.alive[e]) global_min = std::min(global_min, score[e]);
+    std::size_t this_pass = 0;
+    for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
+      const bool sliding = fixed[v] && o.slides != nullptr && (*o.slides)[v][0] != kNoNode;
+      if ((fixed[v] && !sliding) || at[v].empty()) continue;
+      const auto x = m.point(v);
+      double sum[3] = {0, 0, 0}, weights = 0, old_min = 2.0, old_sum = 0;
+      for (std::uint32_t e : at[v]) {
+        old_min = std::min(old_min, score[e]);
+        old_sum += score[e];
+        const int c = corner_of(m.elements[e], v);
+        for (NodeIndex j : {next_corner(m.elements[e], c), prev_corner(m.elements[e], c)}) {
+          const auto y = m.point(j);
+          double w = 1.0;
+          if (o.size_field != nullptr)
+            w = 1.0 / (*o.size_field)(0.5 * (x[0] + y[0]), 0.5 * (x[1] + y[1]),
+                                      0.5 * (x[2] + y[2]));
+          for (int d = 0; d < 3; ++d) sum[d] += w * y[d];
+          weights += w;
+        }
+      }
+      std::array<double, 3> move{sum[0] / weights - x[0], sum[1] / weights - x[1],
+                                 sum[2] / weights - x[2]};
+      std::array<double, 3> a{}, along{};
+      if (sliding) {
+        a = m.point((*o.slides)[v][0]);
+        const auto b = m.point((*o.slides)[v][1]);
+        along = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+        const double ll = along[0] * along[0] + along[1] * along[1] + along[2] * along[2];
+        const double t = (move[0] * along[0] + move[1] * along[1] + move[2] * along[2]) / ll;
+        for (int d = 0; d < 3; ++d) move[d] = t * along[d];
+      }
+      for (double fraction : {1.0, 0.5}) {
+        if (sliding) {
+          double s = 0, ll = 0;
+          for (int d = 0; d < 3; ++d) {
+            s += (x[d] + fraction * move[d] - a[d]) * along[d];
+            ll += along[d] * along[d];
+          }
+          if (!(s > 0 && s < ll)) continue;
+        }
+        for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d] + fraction * move[d];
+        double new_min = 2.0, new_sum = 0;
+        std::vector<double> trial;
+        for (std::uint32_t e : at[v]) {
+          trial.push_back(element_score(m, e));
+          new_min = std::min(new_min, trial.back());
+          new_sum += trial.back();
+        }
+        if (new_min >= old_min ||
+            (raise_mean && new_min >= global_min && new_min > 0 && new_sum > old_sum)) {
+          for (std::size_t i = 0; i < at[v].size(); ++i) score[at[v][i]] = trial[i];
+          ++this_pass;
+          break;
+        }
+        for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d];
+      }
+    }
+    accepted += this_pass;
+    if (this_pass == 0 && raise_mean) break;
+  }
+  return accepted;
+}
+
+// A jittered nx x ny grid of quads on [0, nx] x [0, ny], some cells split into two triangles,
+// some jitters large enough for inverted quads; the last cell's elements are removed (dead).
+MixedMesh jittered_mixed_grid(int nx, int ny, double jitter, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  MixedMesh m;
+  auto id = [&](int i, int j) { return static_cast<NodeIndex>((nx + 1) * j + i); };
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) {
+      const bool inside = i > 0 && j > 0 && i < nx && j < ny;
+      m.add_node({i + (inside ? jitter * unit(rng) : 0.0), j + (inside ? jitter * unit(rng) : 0.0),
+                  0.0},
+                 static_cast<Tag>(id(i, j) + 1));
+    }
+  auto add = [&](std::array<NodeIndex, 4> el, bool alive) {
+    m.elements.push_back(el);
+    m.region.push_back(0);
+    m.normal.push_back({0, 0, 1});
+    m.alive.push_back(alive);
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const bool alive = !(i == nx - 1 && j == ny - 1);
+      if ((i * 7 + j * 3) % 11 == 0) {
+        add({id(i, j), id(i + 1, j), id(i + 1, j + 1), kNoNode}, alive);
+        add({id(i, j), id(i + 1, j + 1), id(i, j + 1), kNoNode}, alive);
+      } else {
+        add({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)}, alive);
+      }
+    }
+  return m;
+}
+
+double worst_alive_score(const MixedMesh& m) {
+  double w = 2.0;
+  for (std::size_t e = 0; e < m.elements.size(); ++e)
+    if (m.alive[e]) w = std::min(w, element_score(m, e));
+  return w;
+}
+
+TEST(Smooth, SameBitsAsThePlainSweep) {
+  const SizeFunction size = [](double x, double y, double) { return 0.5 + 0.1 * x + 0.05 * y; };
+  for (unsigned seed = 1; seed <= 6; ++seed) {
+    const MixedMesh start = jittered_mixed_grid(9, 7, seed % 2 ? 0.3 : 0.55, seed);
+    const std::vector<char> fixed = region_boundary_nodes(start);
+    const auto slides = straight_boundary_slides(start, fixed);
+    SmoothingOptions options;
+    options.passes = 4;
+    options.slides = &slides;
+    if (seed > 3) options.size_field = &size;
+    MixedMesh fast = start, plain = start;
+    const std::size_t moves = smooth(fast, fixed, options);
+    EXPECT_EQ(moves, plain_smooth(plain, fixed, options)) << "seed " << seed;
+    EXPECT_GT(moves, 0u);
+    ASSERT_EQ(fast.coords.size(), plain.coords.size());
+    for (std::size_t i = 0; i < fast.coords.size(); ++i)
+      ASSERT_EQ(fast.coords[i], plain.coords[i]) << "seed " << seed << " coordinate " << i;
+  }
+}
+
+TEST(Smooth, NeverLowersTheWorstScoreNorInverts) {
+  for (unsigned seed = 1; seed <= 8; ++seed) {
+    MixedMesh m = jittered_mixed_grid(12, 10, 0.35, seed);
+    const std::vector<char> fixed = region_boundary_nodes(m);
+    const auto slides = straight_boundary_slides(m, fixed);
+    std::vector<char> valid(m.elements.size());
+    for (std::size_t e = 0; e < m.elements.size(); ++e) valid[e] = element_score(m, e) > 0;
+    const double before = worst_alive_score(m);
+    const MixedMesh start = m;
+    SmoothingOptions options;
+    options.slides = &slides;
+    EXPECT_GT(smooth(m, fixed, options), 0u);
+    EXPECT_GE(worst_alive_score(m), before) << "seed " << seed;
+    for (std::size_t e = 0; e < m.elements.size(); ++e) {
+      if (m.alive[e] && valid[e]) {
+        EXPECT_GT(element_score(m, e), 0.0) << "seed " << seed;
+      }
+    }
+    // The boundary keeps its shape: a fixed node stays, a sliding one stays on the line
+    // through its two neighbours' first positions.
+    for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
+      if (!fixed[v]) continue;
+      const auto p = m.point(v), p0 = start.point(v);
+      if (slides[v][0] == kNoNode) {
+        EXPECT_EQ(p, p0) << "seed " << seed << " node " << v;
+        continue;
+      }
+      const auto a = start.point(slides[v][0]), b = start.point(slides[v][1]);
+      const double cross = (p[0] - a[0]) * (b[1] - a[1]) - (p[1] - a[1]) * (b[0] - a[0]);
+      EXPECT_NEAR(cross, 0.0, 1e-12) << "seed " << seed << " node " << v;
+    }
+  }
+}
 
 // 2 x 2 unit squares whose centre node is pulled to (1.3, 1.2): the polish must bring it back
 // near (1, 1), where all four quads are squares (eta = 1), never lowering the worst score.
