@@ -83,8 +83,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
                                  TableSource source)
     : type_(&type), basis_(&basis), dim_(type.dim), order_(type.order) {
   if (type.family == ElementFamily::pyramid) {
-    init_pyramid();  // exact data and tables at once (src/analysis/pyramid_space.cpp)
-    std::call_once(exact_once_, [] {});
+    init_pyramid(source);  // src/analysis/pyramid_space.cpp
     build_kernel_tables();
     return;
   }
@@ -194,6 +193,10 @@ void JacobianProduct::build_exact() const {
 }
 
 void JacobianProduct::build_exact_data() const {
+  if (type_->family == ElementFamily::pyramid) {
+    build_pyramid_exact_data();
+    return;
+  }
   const int p = order_;
   const BezierBasis& basis = *basis_;
   // Exact per-factor derivative maps (scaled rows): factor h != f(c): mult(a) T_h[a][l];
@@ -317,11 +320,21 @@ JacobianProduct::Product JacobianProduct::make_product(const Space& a, const Spa
     const auto ia = simplex_multi_indices(d, a.degree[hs]), ib = simplex_multi_indices(d, b.degree[hs]),
                ic = simplex_multi_indices(d, c.degree[hs]);
     std::vector<int> terms(ic.size(), 0);
+    // Where each multi-index of c sits, by its components 1-3 (component 0 follows from
+    // the degree): a table lookup, not a search (the search was most of a type's set-up).
+    const auto nc = static_cast<std::size_t>(c.degree[hs] + 1);
+    std::vector<int> where(nc * nc * nc, -1);
+    const auto key = [nc](const MultiIndex& m) {
+      return (static_cast<std::size_t>(m[1]) * nc + static_cast<std::size_t>(m[2])) * nc + static_cast<std::size_t>(m[3]);
+    };
+    for (std::size_t z = 0; z < ic.size(); ++z) where[key(ic[z])] = static_cast<int>(z);
     for (std::size_t x = 0; x < ia.size(); ++x)
       for (std::size_t y = 0; y < ib.size(); ++y) {
         MultiIndex s;
         for (std::size_t k = 0; k < 4; ++k) s[k] = ia[x][k] + ib[y][k];
-        const int z = index_of(ic, s);
+        const std::size_t at = key(s);
+        const int z = at < where.size() ? where[at] : -1;
+        QV_ASSERT(z >= 0 && ic[static_cast<std::size_t>(z)] == s, "multi-index outside the product space");
         p.pairs[hs].push_back({static_cast<int>(x), static_cast<int>(y), z});
         ++terms[static_cast<std::size_t>(z)];
       }
@@ -518,15 +531,17 @@ void JacobianProduct::build_map_tables(SampleMap which) {
 }
 
 JacobianProduct::Gather JacobianProduct::make_gather(const Product& p, int outputs) const {
-  // Bucket the terms by output, keeping for_each_term's order within each output.
-  std::vector<std::vector<std::array<int, 2>>> by_output(static_cast<std::size_t>(outputs));
-  for_each_term(p, [&](int a, int b, int c) { by_output[static_cast<std::size_t>(c)].push_back({a, b}); });
+  // Bucket the terms by output, keeping for_each_term's order within each output: a
+  // counting sort (two passes, two allocations; a vector per output was most of the
+  // set-up time of a type with generated tables).
+  const auto outs = static_cast<std::size_t>(outputs);
   Gather g;
-  g.first.push_back(0);
-  for (const auto& list : by_output) {
-    g.terms.insert(g.terms.end(), list.begin(), list.end());
-    g.first.push_back(static_cast<int>(g.terms.size()));
-  }
+  g.first.assign(outs + 1, 0);
+  for_each_term(p, [&](int, int, int c) { ++g.first[static_cast<std::size_t>(c) + 1]; });
+  for (std::size_t k = 0; k < outs; ++k) g.first[k + 1] += g.first[k];
+  g.terms.resize(static_cast<std::size_t>(g.first[outs]));
+  std::vector<int> fill(g.first.begin(), g.first.end() - 1);
+  for_each_term(p, [&](int a, int b, int c) { g.terms[static_cast<std::size_t>(fill[static_cast<std::size_t>(c)]++)] = {a, b}; });
   return g;
 }
 

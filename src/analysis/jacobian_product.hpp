@@ -71,8 +71,9 @@ class JacobianProduct {
   /// @pre type a Lagrange line, triangle, quadrangle, tetrahedron, prism or hexahedron
   ///      (or pyramid, src/analysis/pyramid_space.cpp); basis = bezier_basis(type.family,
   ///      type.order)
-  /// With generated tables the exact rational data (GMP) is built only on the first
-  /// exact_coefficients call (thread-safe), so the set-up of a type costs microseconds.
+  /// With generated tables (pyramids included) the exact rational data (GMP) is built only
+  /// on the first exact_coefficients call (thread-safe), so the set-up of a type costs
+  /// microseconds.
   JacobianProduct(const ElementType& type, const BezierBasis& basis,
                   TableSource source = TableSource::generated_or_exact);
 
@@ -150,7 +151,11 @@ class JacobianProduct {
   void lane_block(const Map& map, const double* nodes, std::size_t stride, bool planar,
                   double* coeffs, double* errors, double* buf) const;
   std::size_t block_size(const Map& map, int lanes) const;
-  void init_pyramid();  // src/analysis/pyramid_space.cpp (Paper IV, cube coordinates)
+  // Pyramids (src/analysis/pyramid_space.cpp, Paper IV, cube coordinates): the spaces and
+  // products, then the rounded tables (generated, or rounded from the exact data)...
+  void init_pyramid(TableSource source);
+  void build_pyramid_exact_data() const;  // ...and the exact data: mult_, Map::pyramid
+  void build_pyramid_rounded_tables();
   std::vector<mpq_class> exact_derivative(int c, const std::vector<mpq_class>& lattice_values) const;
 
   const ElementType* type_;
@@ -178,7 +183,7 @@ class JacobianProduct {
   Product dot_;    // 3D: X_xi . (X_eta x X_zeta)
   Gather cross_gather_, dot_gather_;  // cross_ and dot_ by output, same summation order
   double rounding_ = 0;  // relative rounding of the products and the final scaling
-  mutable std::array<Map, 2> maps_;  // mutable for Map::to_lattice only (build_exact)
+  mutable std::array<Map, 2> maps_;  // mutable for Map::to_lattice, Map::pyramid (build_exact)
 };
 
 }  // namespace quadval

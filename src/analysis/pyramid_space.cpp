@@ -31,6 +31,7 @@
 #include "analysis/exact_inverse.hpp"
 #include "analysis/jacobian_product.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/product_tables.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
@@ -219,7 +220,21 @@ std::vector<mpq_class> pyramid_scaled_derivative(int r, int c, const std::vector
   return result;
 }
 
-void JacobianProduct::init_pyramid() {
+namespace {
+
+// mult(k) of a pyramid space: the product of the binomials of k's per-axis indices.
+mpz_class pyramid_mult(const std::array<int, 3>& degree, int k) {
+  mpz_class w = 1;
+  for (std::size_t h = 0; h < 3; ++h) {
+    w *= binomial(degree[h], k % (degree[h] + 1));
+    k /= degree[h] + 1;
+  }
+  return w;
+}
+
+}  // namespace
+
+void JacobianProduct::init_pyramid(TableSource source) {
   const int r = order_;
   const ElementType& type = *type_;
   num_factors_ = r == 1 ? 2 : 3;  // r = 1: J does not depend on t (Paper IV §4.1)
@@ -238,35 +253,17 @@ void JacobianProduct::init_pyramid() {
     }
     return s;
   };
-  const auto mult_of = [](const Space& s, int k) {
-    mpz_class w = 1;
-    for (std::size_t h = 0; h < 3; ++h) {
-      w *= binomial(s.degree[h], k % s.size[h]);
-      k /= s.size[h];
-    }
-    return w;
-  };
   std::array<int, 3> jdeg{0, 0, 0};
   for (int c = 0; c < 3; ++c) {
     const auto cs = static_cast<std::size_t>(c);
     deriv_space_[cs] = space_of(pyramid_derivative_degrees(r, c));
     for (std::size_t h = 0; h < 3; ++h) jdeg[h] += deriv_space_[cs].degree[h];
-    auto& inv = deriv_inv_mult_[cs];
-    inv.resize(static_cast<std::size_t>(deriv_space_[cs].total));
-    for (int k = 0; k < deriv_space_[cs].total; ++k)
-      inv[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(mult_of(deriv_space_[cs], k)));
   }
   const Space jspace = space_of(jdeg);
   QV_ASSERT(jspace.total == basis_->size() && static_cast<int>(basis_->factors().size()) == num_factors_,
             "J space of " << type.name << " differs from its basis");
   for (int h = 0; h < num_factors_; ++h)
     QV_ASSERT(basis_->factors()[static_cast<std::size_t>(h)]->degree() == jdeg[static_cast<std::size_t>(h)], "pyramid basis degree");
-  mult_.resize(static_cast<std::size_t>(jspace.total));
-  inv_mult_.resize(mult_.size());
-  for (int k = 0; k < jspace.total; ++k) {
-    mult_[static_cast<std::size_t>(k)] = mult_of(jspace, k);
-    inv_mult_[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(mult_[static_cast<std::size_t>(k)]));
-  }
   std::array<int, 3> bc{0, 0, 0};
   for (std::size_t h = 0; h < 3; ++h) bc[h] = deriv_space_[1].degree[h] + deriv_space_[2].degree[h];
   const Space bcs = space_of(bc);
@@ -274,15 +271,51 @@ void JacobianProduct::init_pyramid() {
   cross_ = make_product(deriv_space_[1], deriv_space_[2], bcs);
   dot_ = make_product(deriv_space_[0], bcs, jspace);
   rounding_ = rounding_gamma(3 * dot_.max_terms + 2 * cross_.max_terms) + 2.01 * 0x1p-53;
+  maps_[static_cast<std::size_t>(SampleMap::curved)].num_nodes = type.num_nodes;
+  maps_[static_cast<std::size_t>(SampleMap::straight)].num_nodes = 5;
 
-  // Curved map: the type's own shape functions; straight: the 5-node pyramid's, in the
-  // same derivative spaces (lower degrees written in the higher-degree Bernstein bases).
+  // The rounded tables: generated at build time (product_tables.hpp; the exact data is then
+  // built only when exact_coefficients first asks for it), else rounded here.
+  const ProductTableView* generated =
+      source == TableSource::generated_or_exact ? generated_product_tables(type.gmsh_id) : nullptr;
+  if (generated != nullptr) {
+    load_tables(*generated);
+  } else {
+    build_exact();
+    build_pyramid_rounded_tables();
+  }
+}
+
+void JacobianProduct::build_pyramid_exact_data() const {
+  // mult(gamma) of the J space (degrees: the basis's factors; 1 for a missing third).
+  std::array<int, 3> jdeg{0, 0, 0};
+  for (int h = 0; h < num_factors_; ++h)
+    jdeg[static_cast<std::size_t>(h)] = basis_->factors()[static_cast<std::size_t>(h)]->degree();
+  mult_.resize(static_cast<std::size_t>(basis_->size()));
+  for (int k = 0; k < basis_->size(); ++k) mult_[static_cast<std::size_t>(k)] = pyramid_mult(jdeg, k);
+  // Curved map: the type's own shape functions; straight: the 5-node pyramid's.
   for (SampleMap which : {SampleMap::curved, SampleMap::straight}) {
-    Map& map = maps_[static_cast<std::size_t>(which)];
-    const ElementType& shape = which == SampleMap::curved ? type : *find_element_type(ElementFamily::pyramid, 1, true);
-    PyramidShapeCoefficients sc = pyramid_shape_coefficients(shape);
-    const auto n = static_cast<std::size_t>(shape.num_nodes);
-    map.num_nodes = shape.num_nodes;
+    const ElementType& shape = which == SampleMap::curved ? *type_ : *find_element_type(ElementFamily::pyramid, 1, true);
+    maps_[static_cast<std::size_t>(which)].pyramid =
+        std::make_shared<const PyramidShapeCoefficients>(pyramid_shape_coefficients(shape));
+  }
+}
+
+void JacobianProduct::build_pyramid_rounded_tables() {
+  for (int c = 0; c < 3; ++c) {
+    const auto cs = static_cast<std::size_t>(c);
+    auto& inv = deriv_inv_mult_[cs];
+    inv.resize(static_cast<std::size_t>(deriv_space_[cs].total));
+    for (int k = 0; k < deriv_space_[cs].total; ++k)
+      inv[static_cast<std::size_t>(k)] = nearest_double(mpq_class(1) / mpq_class(pyramid_mult(deriv_space_[cs].degree, k)));
+  }
+  inv_mult_.resize(mult_.size());
+  for (std::size_t k = 0; k < mult_.size(); ++k) inv_mult_[k] = nearest_double(mpq_class(1) / mpq_class(mult_[k]));
+  // The derivative maps of both geometries in the same derivative spaces (the straight
+  // map's lower degrees written in the higher-degree Bernstein bases).
+  for (Map& map : maps_) {
+    const PyramidShapeCoefficients& sc = *map.pyramid;
+    const auto n = static_cast<std::size_t>(map.num_nodes);
     for (int c = 0; c < 3; ++c) {
       const auto cs = static_cast<std::size_t>(c);
       const auto rows = static_cast<std::size_t>(deriv_space_[cs].total);
@@ -291,7 +324,7 @@ void JacobianProduct::init_pyramid() {
       std::vector<mpq_class> row_abs(rows, mpq_class(0)), column(n);
       for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t j = 0; j < n; ++j) column[j] = sc.coefficients[j * n + i];
-        const std::vector<mpq_class> d = pyramid_scaled_derivative(r, c, sc.exponents, column);
+        const std::vector<mpq_class> d = pyramid_scaled_derivative(order_, c, sc.exponents, column);
         for (std::size_t k = 0; k < rows; ++k) {
           g[k * n + i] = nearest_double(d[k]);
           row_abs[k] += abs(d[k]);
@@ -302,7 +335,6 @@ void JacobianProduct::init_pyramid() {
         worst = std::max(worst, mpq_class(row_abs[k] * mpq_class(deriv_inv_mult_[cs][k]) * (1 + mpq_class(1, 1 << 20))));
       map.row_sum[cs] = round_up(worst);
     }
-    map.pyramid = std::make_shared<const PyramidShapeCoefficients>(std::move(sc));
   }
 }
 
