@@ -400,20 +400,18 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     ws.heap.pop_back();
     ++out.subdivisions;
     ws.free_slots.push_back(top.slot);
-    // The parent's slot is reused by its children: copy it out first.
     const std::size_t parent_off = static_cast<std::size_t>(top.slot) * stride;
-    ws.parent.assign(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
-                     ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
     ws.parent_err.assign(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
                          ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
-    const auto& parent = ws.parent;
     const auto& parent_err = ws.parent_err;
+    // The parent is copied out first: its slot is reused by its children.
+    ws.parent.assign(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
+                     ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
+    for (std::size_t v = 0; v < nvec; ++v)
+      child_err[v] = up((parent_err[v] + b2.subdivision_rounding() * max_abs(ws.parent.data() + v * s2, s2)) * (1 + 1e-12));
     for (int q = 0; q < b2.num_children(); ++q) {
-      for (std::size_t v = 0; v < nvec; ++v) {
-        const double* p = parent.data() + v * s2;
-        b2.subdivide(q, p, child.data() + v * s2, ws.work.data());
-        child_err[v] = up((parent_err[v] + b2.subdivision_rounding() * max_abs(p, s2)) * (1 + 1e-12));
-      }
+      // All nvec vectors at once: each child's matrix is read once (bit-identical).
+      b2.subdivide_many(q, ws.parent.data(), nvec, child.data(), ws.work.data());
       int slot;
       if (!ws.free_slots.empty()) {
         slot = ws.free_slots.back();

@@ -2,6 +2,7 @@
 // Bernstein simplex factors, applied factor by factor. Thesis, Paper III §4.3, Table 1.
 #include "quadval/bezier_basis.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -207,6 +208,32 @@ void BezierBasis::subdivide(int child, const double* parent, double* out,
     return std::pair{factors_[f]->subdivision(digits[f]).data(),
                      factors_[f]->subdivision_transposed(digits[f]).data()};
   });
+}
+
+void BezierBasis::subdivide_many(int child, const double* parents, std::size_t count,
+                                 double* out, double* scratch) const {
+  const auto s = static_cast<std::size_t>(size_);
+  if (factors_.size() != 1) {  // tensor factors are small: one vector at a time
+    for (std::size_t v = 0; v < count; ++v) subdivide(child, parents + v * s, out + v * s, scratch);
+    return;
+  }
+  // As apply_factors' single-vector loop (out[a] += column j * parent[j], j increasing),
+  // with the columns taken in blocks that every vector uses while they are in cache.
+  const double* mt = factors_[0]->subdivision_transposed(child_digits(child)[0]).data();
+  std::fill(out, out + s * count, 0.0);
+  constexpr std::size_t kBlock = 32;
+  for (std::size_t j0 = 0; j0 < s; j0 += kBlock) {
+    const std::size_t j1 = std::min(s, j0 + kBlock);
+    for (std::size_t v = 0; v < count; ++v) {
+      double* d = out + v * s;
+      const double* p = parents + v * s;
+      for (std::size_t j = j0; j < j1; ++j) {
+        const double w = p[j];
+        const double* col = mt + j * s;
+        for (std::size_t a = 0; a < s; ++a) d[a] += col[a] * w;
+      }
+    }
+  }
 }
 
 const BezierBasis& bezier_basis(ElementFamily family, int order) {

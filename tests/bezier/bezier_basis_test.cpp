@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <tuple>
 
@@ -302,6 +303,32 @@ INSTANTIATE_TEST_SUITE_P(
                                      ElementFamily::quadrangle, ElementFamily::tetrahedron,
                                      ElementFamily::prism, ElementFamily::hexahedron),
                      testing::Range(1, 4)));
+
+// subdivide_many (several vectors, the matrix read once) gives the bits of subdivide applied
+// to each vector: same products, summed in the same order.
+TEST(BezierBasis, SubdivideManyEqualsSubdivideBitForBit) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> coef(-1, 1);
+  for (const auto& [family, order] : std::vector<std::pair<ElementFamily, int>>{
+           {ElementFamily::line, 5}, {ElementFamily::triangle, 4}, {ElementFamily::triangle, 9},
+           {ElementFamily::tetrahedron, 2}, {ElementFamily::tetrahedron, 4},
+           {ElementFamily::prism, 2}, {ElementFamily::hexahedron, 2}}) {
+    const BezierBasis& b = bezier_basis(family, order);
+    const auto s = static_cast<std::size_t>(b.size());
+    for (std::size_t count : {1u, 3u, 6u, 9u}) {
+      std::vector<double> parents(s * count), many(s * count), one(s), scratch(2 * s);
+      for (double& x : parents) x = coef(rng);
+      for (int q = 0; q < b.num_children(); ++q) {
+        b.subdivide_many(q, parents.data(), count, many.data(), scratch.data());
+        for (std::size_t v = 0; v < count; ++v) {
+          b.subdivide(q, parents.data() + v * s, one.data(), scratch.data());
+          EXPECT_EQ(std::memcmp(one.data(), many.data() + v * s, s * sizeof(double)), 0)
+              << family_name(family) << " order " << order << " child " << q << " vector " << v;
+        }
+      }
+    }
+  }
+}
 
 }  // namespace
 }  // namespace quadval
