@@ -797,9 +797,9 @@ class Solver {
 // vertex reaches them; edges by their lower new endpoint), so that the vertices a tree grows
 // over, and their edges, sit close together in memory. The solver is bound by memory latency:
 // on square-hole-100k/300k (nearly the same events and the same matching) CPU time went
-// 0.83 -> 0.65 s and 4.05 -> 3.21 s (medians of 3). The greedy start, which visits vertices in
+// 0.77 -> 0.55 s and 3.43 -> 2.60 s (medians of 3). The greedy start, which visits vertices in
 // index order, also leaves fewer vertices free in this order (uniform-100k: 4,238 -> 1,312
-// free, 8.9 -> 4.5 s).
+// free, 7.95 -> 4.15 s).
 struct LocalGraph {
   std::vector<CostEdge> edges;           // renumbered
   std::vector<std::uint32_t> edge_from;  // original index of each renumbered edge

@@ -10,7 +10,7 @@
 // non-perfect fallback): equal optimum everywhere tested, and about as fast (graded square
 // with a hole, 100k triangles: 0.76 s vs 0.71 s; 300k: 3.8 s vs 4.3 s). The graph is solved in
 // breadth-first order (see min_cost_perfect_matching): CPU time, medians of 3, before -> after:
-// square-hole-100k 0.83 -> 0.65 s, square-hole-300k 4.05 -> 3.21 s, uniform-100k 8.9 -> 4.5 s.
+// square-hole-100k 0.77 -> 0.55 s, square-hole-300k 3.43 -> 2.60 s, uniform-100k 7.95 -> 4.15 s.
 //
 // Both solvers grow faster than linearly on large meshes, and the time goes to the last
 // augmentations. Measured (event counts per augmentation): on square-hole-100k the first 7,000
