@@ -15,8 +15,8 @@
 // Both solvers grow faster than linearly on large meshes, and the time goes to the last
 // augmentations. Measured (event counts per augmentation): on square-hole-100k the first 7,000
 // of 7,489 augmentations take a third of the time; the last one grows a tree over 91,519 of the
-// 99,778 vertices; on square-hole-1M the last 90 of 69,544 take half of the 20 s, the last one
-// a tree of 703,909 vertices. These are shortest augmenting paths between the last free
+// 99,778 vertices; on square-hole-1M the last 90 of 69,544 take about half the time, the last
+// one a tree of 703,909 vertices. These are shortest augmenting paths between the last free
 // vertices, far apart, at a large dual value (1.5 in cost units), where nearly every edge is
 // tight: any method that augments one shortest path at a time (Edmonds' primal-dual, LEMON,
 // Blossom V) must visit every vertex nearer than that path, i.e. the whole mesh, for each of
