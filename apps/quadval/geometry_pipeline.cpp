@@ -24,13 +24,6 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-std::size_t count_family(const Mesh& mesh, ElementFamily family) {
-  std::size_t n = 0;
-  for (const ElementBlock& b : mesh.blocks)
-    if (b.type->family == family) n += b.size();
-  return n;
-}
-
 // eta (Paper I eq. 3) of each element in block order; NaN for anything but a quadrangle, so
 // that pictures draw it grey and histograms skip it.
 std::vector<double> element_eta(const Mesh& mesh) {

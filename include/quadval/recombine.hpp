@@ -138,7 +138,8 @@ struct RecombineResult {
   /// Quads (Gmsh type 3) in one block per input surface entity, orientation as the input
   /// triangles (made consistent per connected region); triangles left (greedy, or no perfect
   /// matching) in type-2 blocks. Nodes: those the elements use, original tags kept, new
-  /// nodes numbered after the largest input tag. Entities and physical names are copied;
+  /// nodes numbered after the largest input tag, listed by increasing tag (so in the input's
+  /// order, new nodes last). Entities and physical names are copied;
   /// 0D/1D elements are not carried over.
   Mesh mesh;
   RecombineStats stats;

@@ -14,6 +14,7 @@
 #include "lookahead_parity.hpp"
 #include "matching.hpp"
 #include "mixed_mesh.hpp"
+#include "node_order.hpp"
 #include "quad_cleanup.hpp"
 #include "quadval/error.hpp"
 #include "recombine_stats.hpp"
@@ -133,8 +134,14 @@ Mesh to_mesh(const MixedMesh& m, const Mesh& input, const TriangleSurface& s) {
     if (!m.alive[e]) continue;
     for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i) new_index[m.elements[e][i]] = 0;
   }
-  for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
-    if (new_index[v] == kNoNode) continue;
+  // The used nodes by increasing tag: the input's order (MSH tags, or 1, 2, ... for formats
+  // without tags), nodes added by repairs and splits last.
+  std::vector<NodeIndex> used;
+  for (NodeIndex v = 0; v < m.num_nodes(); ++v)
+    if (new_index[v] != kNoNode) used.push_back(v);
+  std::sort(used.begin(), used.end(),
+            [&](NodeIndex a, NodeIndex b) { return m.node_tags[a] < m.node_tags[b]; });
+  for (NodeIndex v : used) {
     new_index[v] = static_cast<NodeIndex>(out.node_tags.size());
     out.node_tags.push_back(m.node_tags[v]);
     for (int d = 0; d < 3; ++d) out.coords.push_back(m.coords[3 * std::size_t{v} + d]);
@@ -168,6 +175,7 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   StageTimer timer(stats, options);
 
   TriangleSurface s = prepare_triangles(input, options.source, result.warnings);
+  order_nodes_along_curve(s);  // memory locality; the output keeps the input's node order
   stats.input_triangles = s.triangles.size();
   if (options.cost == PairCostKind::cross_field && !options.cross_field_per_triangle.empty() &&
       options.cross_field_per_triangle.size() != s.triangles.size())

@@ -199,7 +199,9 @@ TEST(BlossomOptimality, EqualsNetworkXOnMidSizeMeshes) {
     for (auto i : got.pairs) got_nanos += -matching_weight(g.pairs[i].cost);
     // NetworkX gives a maximum-cardinality matching: perfect exactly when one exists.
     EXPECT_EQ(got.perfect, 2 * nx_pairs == g.num_triangles);
-    if (got.perfect) EXPECT_EQ(got_nanos, nx_cost);  // integer weights: exact
+    if (got.perfect) {
+      EXPECT_EQ(got_nanos, nx_cost);  // integer weights: exact
+    }
   }
 }
 

@@ -1,0 +1,18 @@
+#pragma once
+// Nodes renumbered along a space-filling curve, so that nodes near in space are near in
+// memory: the smoothing sweeps visit the nodes in index order and read their neighbours'
+// coordinates, which on meshes numbered by a Delaunay refinement's insertion order (Gmsh's
+// Frontal-Delaunay: spatially scattered) miss the cache at every step. Measured on
+// square-hole-300k: smoothing 1.53 -> 0.71 s.
+
+#include "triangle_input.hpp"
+
+namespace quadval::recombine_detail {
+
+/// Renumbers the nodes of `s` in Z-order (Morton order, 21 bits per axis over the bounding
+/// box of the finite coordinates; ties and non-finite coordinates keep their input order):
+/// permutes coords and node_tags and remaps the triangles. Triangles, their order and
+/// everything indexed by triangle are unchanged, and so is the dual graph.
+void order_nodes_along_curve(TriangleSurface& s);
+
+}  // namespace quadval::recombine_detail
