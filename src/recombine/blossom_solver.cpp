@@ -93,8 +93,6 @@ class Solver {
     std::vector<std::uint32_t> degree(n + 1, 0);
     for (std::size_t e = 0; e < edges.size(); ++e) {
       const CostEdge& ce = edges[e];
-      QV_ASSERT(ce.u < n && ce.v < n && ce.u != ce.v,
-                "edge " << e << " (" << ce.u << ", " << ce.v << ") in a graph of " << n);
       QV_ASSERT(ce.cost <= kMaxMatchingCost && ce.cost >= -kMaxMatchingCost,
                 "edge cost " << ce.cost);
       cost_[e] = 2 * ce.cost;
@@ -852,6 +850,7 @@ LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges)
 
 bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
                                std::vector<char>& matched, const MatchingProgress& progress) {
+  // Checked here, in the caller's numbering (the solver sees the renumbered graph).
   for (std::size_t e = 0; e < edges.size(); ++e)
     QV_ASSERT(edges[e].u < num_nodes && edges[e].v < num_nodes && edges[e].u != edges[e].v,
               "edge " << e << " (" << edges[e].u << ", " << edges[e].v << ") in a graph of "
