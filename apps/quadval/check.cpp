@@ -189,14 +189,14 @@ void add_check_command(CLI::App& app, int& exit_code) {
   cmd->add_option("mesh", o->input, "Mesh to check (.msh 2.2/4.1, ASCII or binary)")->required();
   cmd->add_option("--measure", o->measure,
                   "validity: settle the sign of min J; jacobian: also bound min J and max J within\n"
-                  "--tol; distortion: also min J / J_straight (Paper III eq. 3); mu: validity and\n"
-                  "bounds on mu; scaled-jacobian: validity and bounds on the scaled Jacobian;\n"
-                  "all: distortion, mu and the scaled Jacobian")
+                  "--tol; distortion: also min J / J_straight (Paper III eq. 3), within --tol too;\n"
+                  "mu: validity and bounds on mu; scaled-jacobian: validity and bounds on the\n"
+                  "scaled Jacobian; all: distortion, mu and the scaled Jacobian")
       ->check(CLI::IsMember({"validity", "jacobian", "distortion", "mu", "scaled-jacobian", "all"}))
       ->capture_default_str();
   cmd->add_option("--tol", o->tol,
-                  "Relative tolerance on the J bounds (jacobian, distortion); absolute tolerance\n"
-                  "on upper - lower of mu and the scaled Jacobian")
+                  "Relative tolerance on the J bounds and on min J / J_straight (jacobian,\n"
+                  "distortion); absolute tolerance on upper - lower of mu and the scaled Jacobian")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   cmd->add_option("--abs-tol", o->abs_tol, "Absolute tolerance on the bounds (the larger one applies)")

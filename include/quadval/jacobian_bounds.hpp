@@ -112,12 +112,14 @@ struct DistortionBounds {
   double upper = 0;  ///< certified upper bound of min delta (a value of delta), or NaN
 };
 
-/// Distortion bounds of one element, from its Jacobian bounds `jb` (simplices: J_straight
-/// is constant, so the refined bounds divide exactly) or, for quadrangles, prisms and
-/// hexahedra, from the ratios of the Bézier coefficients of J and J_straight
-/// (min_i b_i / c_i <= min J / J_straight when every c_i > 0; Paper V §3.1).
+/// Distortion bounds of one element. Simplices: J_straight is constant, so the Jacobian
+/// bounds `jb` divide exactly. Quadrangles, prisms, hexahedra and pyramids: J / J_straight is
+/// a rational function, whose minimum is refined best-first from the Bézier coefficients
+/// of J and J_straight (min_i b_i / c_i <= min J / J_straight when every c_i > 0; Paper V
+/// §3.1) until upper - lower <= max(options.abs_tol, options.rel_tol * |upper|) or
+/// options.max_subdivisions subdomains were split (then the bounds are wider, still certified).
 DistortionBounds distortion_bounds(const ElementType& type, std::span<const double> nodes,
                                    const JacobianBounds& jb, BoundsWorkspace& workspace,
-                                   bool planar = false);
+                                   bool planar = false, const BoundsOptions& options = {});
 
 }  // namespace quadval

@@ -285,7 +285,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               ec.analysed = true;
               const JacobianBounds& b = ec.bounds;
               if (measures_distortion(options.measure))
-                distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws);
+                distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws, bo);
               if (want_mu)
                 quality(mu_supported(type), mu[index], st.mu, xe,
                         [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,

@@ -9,6 +9,7 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/ratio_refinement.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
 
@@ -234,7 +235,8 @@ JacobianBounds bounds_from_samples(const JacobianSpace& space, const double* sam
 }
 
 DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,
-                                 const JacobianBounds& jb, BoundsWorkspace::Impl& ws) {
+                                 const JacobianBounds& jb, BoundsWorkspace::Impl& ws,
+                                 const BoundsOptions& options) {
   const BezierBasis& basis = space.basis();
   const auto s = static_cast<std::size_t>(basis.size());
   DistortionBounds d{std::nan(""), std::nan("")};
@@ -271,7 +273,7 @@ DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes
     d.upper = div_up(jb.jmin_upper, jb.jmin_upper >= 0 ? c_lo : c_hi);
     return d;
   }
-  // min J / J_s >= min_i b_i / c_i when every c_i > 0 (J - m J_s has coefficients >= 0).
+  // J / J_s is a rational function: its minimum refined best-first (ratio_refinement.hpp).
   double err_b;
   if (space.product() != nullptr) {
     err_b = product_coefficients(space, SampleMap::curved, nodes, planar, ws.coeffs, ws);
@@ -283,21 +285,12 @@ DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes
     ws.coeffs.resize(s);
     err_b = to_bezier_with_error(basis, ws.samples.data(), err, ws.coeffs.data(), ws.scratch);
   }
-  double lower = kInf, upper = kInf;
-  for (std::size_t i = 0; i < s; ++i) {
-    const double ci_lo = down(c[i] - err_c), ci_hi = up(c[i] + err_c);
-    if (!(ci_lo > 0)) return d;
-    const double b_lo = down(ws.coeffs[i] - err_b);
-    lower = std::min(lower, div_down(b_lo, b_lo >= 0 ? ci_hi : ci_lo));
-  }
-  for (int v : basis.vertex_indices()) {
-    const auto i = static_cast<std::size_t>(v);
-    const double ci_lo = down(c[i] - err_c), ci_hi = up(c[i] + err_c);
-    const double b_hi = up(ws.coeffs[i] + err_b);
-    upper = std::min(upper, div_up(b_hi, b_hi >= 0 ? ci_lo : ci_hi));
-  }
-  d.lower = lower;
-  d.upper = upper;
+  const RatioRefinement r = refine_ratio_minimum(basis, ws.coeffs.data(), err_b, c.data(), err_c,
+                                                 options.abs_tol, options.rel_tol,
+                                                 options.max_subdivisions);
+  if (!r.positive) return d;
+  d.lower = r.lower;
+  d.upper = r.upper;
   return d;
 }
 
@@ -324,9 +317,9 @@ JacobianBounds jacobian_bounds(const ElementType& type, std::span<const double> 
 
 DistortionBounds distortion_bounds(const ElementType& type, std::span<const double> nodes,
                                    const JacobianBounds& jb, BoundsWorkspace& workspace,
-                                   bool planar) {
+                                   bool planar, const BoundsOptions& options) {
   QV_ASSERT(jacobian_bounds_supported(type), "no Jacobian bounds for " << type.name);
-  return distortion_from(jacobian_space(type), nodes.data(), planar, jb, workspace.impl());
+  return distortion_from(jacobian_space(type), nodes.data(), planar, jb, workspace.impl(), options);
 }
 
 }  // namespace quadval

@@ -92,7 +92,8 @@ inline void jacobian_coefficients(const JacobianSpace& space, const double* node
 
 /// Distortion bounds (see jacobian_bounds.hpp) of one element with bounds jb.
 DistortionBounds distortion_from(const JacobianSpace& space, const double* nodes, bool planar,
-                                 const JacobianBounds& jb, BoundsWorkspace::Impl& ws);
+                                 const JacobianBounds& jb, BoundsWorkspace::Impl& ws,
+                                 const BoundsOptions& options);
 
 
 }  // namespace quadval

@@ -5,6 +5,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/jacobian_samples.cpp
   src/analysis/jacobian_engine.cpp
   src/analysis/jacobian_bounds.cpp
+  src/analysis/ratio_refinement.cpp
   src/analysis/linear_jacobian.cpp
   src/analysis/scaled_jacobian_space.cpp
   src/analysis/scaled_jacobian.cpp

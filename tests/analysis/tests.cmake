@@ -17,5 +17,6 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/jacobian_batch_test.cpp
   analysis/check_threads_test.cpp
   analysis/check_stream_test.cpp
+  analysis/distortion_refine_test.cpp
   analysis/product_tables_test.cpp
 )
