@@ -54,10 +54,15 @@ RatioRefinement refine_ratio_minimum(const BezierBasis& basis, const double* b, 
                                      double rel_tol, int max_subdivisions) {
   const auto s = static_cast<std::size_t>(basis.size());
   RatioRefinement out;
-  // Slots of 2 s doubles: b then c (contiguous, for subdivide_many).
-  std::vector<double> pool(b, b + s), parent(2 * s), scratch(2 * s);
+  // Slots of 2 s doubles: b then c (contiguous, for subdivide_many). Per-thread scratch,
+  // reused from element to element (no allocation once warm).
+  thread_local std::vector<double> pool, parent, scratch;
+  thread_local std::vector<int> free_slots;
+  pool.assign(b, b + s);
   pool.insert(pool.end(), c, c + s);
-  std::vector<int> free_slots;
+  parent.resize(2 * s);
+  scratch.resize(2 * s);
+  free_slots.clear();
   std::priority_queue<Leaf, std::vector<Leaf>, std::greater<>> heap;
   long next_id = 0;
   double upper = vertex_upper(basis, b, err_b, c, err_c);
