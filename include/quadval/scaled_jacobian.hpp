@@ -55,14 +55,26 @@
 /// subdomain sj >= -s sqrt(max_k max_i N_i / D_k,i) (and >= -s by Hadamard).
 /// The Bézier coefficients of N, D_k and J come from Bernstein products (Paper V Prop. 4)
 /// of those of the columns c_j in their own degrees, which are an exact linear map of the
-/// nodes (computed in rational arithmetic once per type, then rounded): no ill-conditioned
-/// Lagrange-to-Bézier conversion of the high-degree space is involved. Every coefficient
-/// carries an a priori bound on its rounding error (the map's row sums, the products'
-/// convex weights, the exact dyadic subdivision), and every bound is rounded outward.
+/// nodes (the Jacobian product path's derivative maps, rounded once from exact
+/// rationals): no ill-conditioned Lagrange-to-Bézier conversion of the high-degree space
+/// is involved. Every coefficient carries an a priori bound on its rounding error (the
+/// map's row sums, the products' convex weights, the averages of the bisections), and
+/// every bound is rounded outward.
 /// upper is the minimum of sj at points (the corners of the subdomains, where a Bézier
 /// coefficient is a value), rounded up by their error bounds. Refinement is best-first
-/// (the subdomain with the smallest lower bound is split) until upper - lower <= abs_tol
-/// or max_subdivisions subdomains were split.
+/// (the subdomain with the smallest lower bound is split into 2^dim children by edge
+/// bisection, bezier/bernstein_bisection.hpp) until upper - lower <= abs_tol or
+/// max_subdivisions subdomains were split.
+///
+/// Folds. Where a frame column vanishes at a point of a fold (J changes sign there),
+/// D_k = 0 and sj has no limit: every subdomain around that point keeps the lower bound
+/// -s (the Hadamard floor), and refining only zooms in on it. The refinement stops early,
+/// with tolerance_met false and the true bounds, once the subdomain with the smallest
+/// bound is proven unable to rise above the floor however far it is split: one of its
+/// corners has J <= 0 (certified) and every coefficient of some D_k is at most its error
+/// bound (bisection never raises the largest coefficient nor lowers the error bound). Only
+/// the upper bound could then still move, and it is bounded below by sj(E): the stop can
+/// only end early an element whose sj(E) lies within abs_tol of the floor.
 
 #include <span>
 
@@ -76,11 +88,12 @@ namespace quadval {
 /// the orders of scaled_jacobian_max_order.
 bool scaled_jacobian_supported(const ElementType& type) noexcept;
 
-/// Highest order handled per family: lines, triangles and quadrangles 6, tetrahedra,
-/// prisms and hexahedra 3 (N and D_k have twice the degree of J: a tetrahedron of order 3
-/// already has 455 coefficients per subdomain and vector, a hexahedron 4913); pyramids 2
-/// (columns of degree r per cube axis, N and D_k of degree 6r: 2197 coefficients at r = 2);
-/// 0 for the other families.
+/// Highest order handled per family: the Jacobian bounds' orders (max_supported_order:
+/// lines 10, triangles 9, quadrangles 8, tetrahedra, prisms and hexahedra 4) and pyramids
+/// 4 (columns of degree r per cube axis, N and D_k of degree 6r: 15625 coefficients per
+/// vector at r = 4, 166375 at the Jacobian's r = 9); 0 for the other families. N and D_k
+/// have twice the degree of J (a tetrahedron of order 4: 1330 coefficients per vector, a
+/// hexahedron 12167), subdivided by bisection without matrices.
 int scaled_jacobian_max_order(ElementFamily family) noexcept;
 
 /// Certified bounds of sj(E) (definition above) for one element. Thread-safe

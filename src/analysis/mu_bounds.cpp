@@ -184,12 +184,15 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // the degree-12n certificate only for elements that kCertificateAfter splits have not
   // settled (near-degenerate ones, where the enclosures of the control matrices lose
   // relative accuracy), and only where the control bound falls short.
+  // Types above mu_certificate_max_order have no certificate (mu_space.hpp): the control
+  // bound alone, whatever mode was asked for.
   constexpr int kCertificateAfter = 24;
+  const int mode = space.has_certificate() ? control_mode : 1;
   const auto subdomain_lower = [&](const double* w, double err, double r_lo, double r_hi) {
     double lo = r_lo;
-    if (control_mode != 0) {
+    if (mode != 0) {
       lo = std::max(lo, scratch.metric.control_lower_bound(space, w, err));
-      if (control_mode == 1 || out.subdivisions < kCertificateAfter || lo >= r_target() ||
+      if (mode == 1 || out.subdivisions < kCertificateAfter || lo >= r_target() ||
           !(std::min(r_hi, 1.0) - lo > tol_r()))
         return lo;
     }

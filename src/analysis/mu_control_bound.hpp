@@ -29,7 +29,8 @@ namespace quadval {
 /// Tests and benchmarks: how mu_bounds bounds a subdomain in the calling thread:
 /// 0 the degree-12n certificate of mu_metric.hpp alone, 1 the control-matrix bound alone,
 /// 2 (default) the control-matrix bound, then, once an element has been split 24 times,
-/// the certificate where the control bound falls short.
+/// the certificate where the control bound falls short. Types without the certificate
+/// (order above mu_certificate_max_order, mu_space.hpp) use 1 whatever the mode.
 void mu_use_control_bound(int mode) noexcept;
 
 /// Certified enclosure of the extreme eigenvalues of a symmetric matrix:

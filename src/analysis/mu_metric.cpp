@@ -121,6 +121,7 @@ double MuMetric::control_lower_bound(const MuSpace& space, const double* w, doub
 
 double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
                              double r_hi, double r_target, double tol_r) {
+  QV_ASSERT(space.has_certificate(), "no mu certificate for " << space.type().name);
   const int dim = space.dim();
   metric_entries(space, w, err);
   const BernsteinProduct& p22 = space.prod(2, 2);

@@ -54,6 +54,7 @@ class MuMetric {
   /// @param r_hi  a known upper bound of min R over the subdomain (e.g. corner values)
   /// @param r_target  a value that suffices: once certified, no bisection above it
   /// @param tol_r stop the 3D bisection once the bracket is this narrow
+  /// @pre space.has_certificate()
   double lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
                      double r_hi, double r_target, double tol_r);
 

@@ -135,8 +135,20 @@ std::array<double, 9> ideal_inverse_of(ElementFamily f) {
 int mu_max_order(ElementFamily family) noexcept {
   switch (family) {
     case ElementFamily::line: return 10;
-    case ElementFamily::triangle:
-    case ElementFamily::quadrangle: return 6;
+    case ElementFamily::triangle: return 9;
+    case ElementFamily::quadrangle: return 8;
+    case ElementFamily::tetrahedron:
+    case ElementFamily::prism:
+    case ElementFamily::hexahedron: return 4;
+    case ElementFamily::pyramid: return 9;
+    default: return 0;
+  }
+}
+
+int mu_certificate_max_order(ElementFamily family) noexcept {
+  switch (family) {
+    case ElementFamily::triangle: return 9;
+    case ElementFamily::quadrangle: return 8;
     case ElementFamily::tetrahedron: return 3;  // 12 n = 24: 2925 coefficients
     case ElementFamily::prism:
     case ElementFamily::hexahedron:
@@ -146,15 +158,22 @@ int mu_max_order(ElementFamily family) noexcept {
 }
 
 void MuSpace::init_w_space(const std::vector<int>& factor_dims, int n) {
+  certificate_ = type_->order <= mu_certificate_max_order(type_->family);
+  // Without the certificate only W (n) and the control matrices of M (2n) are formed.
+  const std::vector<int> multiples =
+      certificate_ ? std::vector<int>{1, 2, 4, 6, 8, 12} : std::vector<int>{1, 2};
   std::vector<const BernsteinSimplex*> w_factors;
   for (int d : factor_dims) {
-    for (int m : {1, 2, 4, 6, 8, 12}) degrees_[m].push_back({d, m * n});
+    for (int m : multiples) degrees_[m].push_back({d, m * n});
     w_factors.push_back(&bernstein_simplex(d, n));
   }
-  for (int m : {1, 2, 4, 6, 8, 12}) sizes_[m] = bernstein_space_size(degrees_[m]);
+  for (int m : multiples) sizes_[m] = bernstein_space_size(degrees_[m]);
   w_basis_ = std::make_unique<BezierBasis>(type_->family, type_->order, w_factors);
-  std::vector<std::pair<int, int>> pairs{{1, 1}, {2, 2}};
-  if (dim_ == 3) pairs.insert(pairs.end(), {{4, 2}, {2, 4}, {4, 4}, {8, 4}, {6, 6}});
+  std::vector<std::pair<int, int>> pairs{{1, 1}};
+  if (certificate_) {
+    pairs.push_back({2, 2});
+    if (dim_ == 3) pairs.insert(pairs.end(), {{4, 2}, {2, 4}, {4, 4}, {8, 4}, {6, 6}});
+  }
   for (const auto& [a, b] : pairs)
     prod_.push_back({{a, b}, &bernstein_product(degrees_[a], degrees_[b])});
   ideal_inv_ = ideal_inverse_of(type_->family);

@@ -16,18 +16,39 @@
 
 namespace quadval {
 
-/// Highest order of each family whose metric polynomials are bounded (the degree-12n
-/// certificate of 3D elements grows as (12 n)^3 coefficients and its products as the
-/// square of the degree-6n spaces): triangles and quadrangles 6, tetrahedra 3, prisms and
-/// hexahedra 2, pyramids 2 (W in the cube coordinates, degree r per factor like a
-/// hexahedron's); lines 10 (mu is 1 or 0); 0 for other families.
+/// Highest order of each family for which mu is bounded: the Jacobian engine's
+/// max_supported_order for every family (triangles 9, quadrangles 8, tetrahedra 4, prisms
+/// and hexahedra 4, pyramids 9; lines 10: mu is 1 or 0); 0 for other families. Above
+/// mu_certificate_max_order the control-matrix bound of mu_control_bound.hpp bounds every
+/// subdomain alone: it is certified on its own and needs only W's space and the degree-2n
+/// product table, so the set-up stays small. Measured (Release, one thread; random
+/// curved elements, abs_tol 1e-2): MuSpace set-up <= 0.06 s and ~1 MB for tetrahedra,
+/// prisms and hexahedra of orders 3-4; pyramids 0.04 s (order 4) to 3.5 s and 12-21 MB
+/// (order 9, 385 nodes: the exact derivative maps of 1000 x 385 rationals per column),
+/// about the Jacobian space's own set-up time (2.9 s) and a sixth of its memory (79 MB),
+/// so pyramids go to order 9 too.
 int mu_max_order(ElementFamily family) noexcept;
+
+/// Highest order of each family whose MuSpace also holds the exact certificate of
+/// mu_metric.hpp (product tables up to degree 4n in 2D, 12n in 3D): triangles 9 and
+/// quadrangles 8 (2D needs degree 4n only: <= 0.09 s, 3 MB at triangle order 9),
+/// tetrahedra 3, prisms, hexahedra and pyramids 2. Above, measured: the tetrahedron of
+/// order 4 needs 6.8 s and 207 MB for its tables; prisms and hexahedra of order 3 build
+/// theirs in 0.3 s, but one (6n, 6n) product takes 4.4 ms resp. 14 ms (hexahedron of order
+/// 2: 1.6 ms; order 4: 61 ms) and a certificate call needs a dozen of them: seconds per
+/// near-degenerate element.
+int mu_certificate_max_order(ElementFamily family) noexcept;
 
 class MuSpace {
  public:
   /// @pre type a Lagrange triangle, quadrangle, tetrahedron, prism, hexahedron or pyramid
   ///      of order 1..mu_max_order(family)
   explicit MuSpace(const ElementType& type);
+
+  /// True when the certificate's data (degrees, sizes and product tables above (1, 1))
+  /// were built: order <= mu_certificate_max_order(family). Otherwise only the control-
+  /// matrix bound (MuMetric::control_lower_bound) may be used on this space.
+  bool has_certificate() const noexcept { return certificate_; }
 
   const ElementType& type() const noexcept { return *type_; }
   int dim() const noexcept { return dim_; }
@@ -39,7 +60,8 @@ class MuSpace {
   /// column degree-elevated from pyramid_derivative_degrees to (r, r, r)).
   const BezierBasis& w_basis() const noexcept { return *w_basis_; }
   int w_size() const noexcept { return w_basis_->size(); }
-  /// Degrees m n per factor, m in {1, 2, 4, 6, 8, 12} (3D; 2D: 1, 2, 4).
+  /// Degrees m n per factor, m in {1, 2, 4, 6, 8, 12} (3D; 2D: 1, 2, 4); without the
+  /// certificate only m in {1, 2} (the others are empty, their sizes 0).
   const std::vector<FactorDegree>& degrees(int m) const noexcept { return degrees_[m]; }
   int size(int m) const noexcept { return sizes_[m]; }
 
@@ -55,14 +77,15 @@ class MuSpace {
   /// 3u of the exact real number (relative).
   const std::array<double, 9>& ideal_inverse() const noexcept { return ideal_inv_; }
 
-  /// Product tables (degrees in units of n): (1, 1), (2, 2); 3D also (4, 2), (2, 4),
-  /// (4, 4), (8, 4), (6, 6).
+  /// Product tables (degrees in units of n): (1, 1); with the certificate also (2, 2), and
+  /// in 3D (4, 2), (2, 4), (4, 4), (8, 4), (6, 6). @pre the table exists (QV_ASSERT)
   const BernsteinProduct& prod(int a, int b) const;
 
  private:
   // The W space (simplex factors of these dimensions, degree n each), its product tables
   // and the ideal element.
   void init_w_space(const std::vector<int>& factor_dims, int n);
+  bool certificate_ = false;
   // Pyramids: derivative maps from Bergot's exact shape functions (pyramid_space.hpp).
   void init_pyramid_derivatives();
 

@@ -14,6 +14,7 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -46,8 +47,9 @@ struct Leaf {
 };
 
 struct Scratch {
-  std::vector<double> values, work, parent, parent_err, child, child_err;
+  std::vector<double> values, work, parent, parent_err, children, child_err;
   std::vector<double> pool, pool_err;
+  std::vector<BisectionState> states, child_states;  // states[slot]: the leaf's bisection state
   std::vector<int> free_slots;
   std::vector<Leaf> heap;
 };
@@ -97,6 +99,29 @@ class Bounder {
     }
     ub = std::min(ub, 1.0);
     return -up(space_.s_hi() * up(std::sqrt(ub)));
+  }
+
+  // The value lower() takes where neither J > 0 nor a bound on N / D_k is proven.
+  double floor() const { return -up(space_.s_hi() * up(std::sqrt(1.0))); }
+
+  // True when no subdomain inside this one can ever get a lower bound above floor():
+  // (1) at one of its vertices J <= 0 is certified, so every subdomain holding that vertex
+  // fails the sign test (J > 0 is not proven there), and (2) for some frame k every
+  // computed coefficient of D_k is at most its error bound: bisection never raises the
+  // largest coefficient nor lowers the error bound (bernstein_bisection.hpp), so D_k is
+  // never proven positive inside either, and the non-positive branch stays at the floor.
+  // This is what happens around a point where a frame column vanishes inside a fold:
+  // there D_k = 0, sj has no limit, and the subdivision only zooms in on that point.
+  bool stuck_at_floor(const double* v, const double* err, std::span<const int> vertices) const {
+    if (valid_) return false;
+    bool nonpositive_vertex = false;
+    for (int i : vertices) nonpositive_vertex = nonpositive_vertex || up(v[i] + err[0]) <= 0;
+    if (!nonpositive_vertex) return false;
+    for (std::size_t k = 0; k < frames_; ++k) {
+      const double* d = v + (2 + k) * size_;
+      if (*std::max_element(d, d + size_) <= err[2 + k]) return true;
+    }
+    return false;
   }
 
   // Certified upper bound of sj at the point where the vectors' entry i are values.
@@ -234,7 +259,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
             "nodes " << nodes.size() << " for " << type.name);
   thread_local Scratch ws;
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
-  const BezierBasis& b2 = space.squared();
+  const BernsteinBisection& b2 = space.squared();
   const auto s2 = static_cast<std::size_t>(b2.size());
   const int dim = type.dim;
   const auto udim = static_cast<std::size_t>(dim);
@@ -244,7 +269,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
 
   // 1. Bézier coefficients of the columns of J_p in their own degrees: an exact linear
   //    map of x_i - x_0 (the maps' rows sum to zero: the translation is exact in the
-  //    definition); error (2u entries + u differences + gamma_N sums) * row sum * R.
+  //    definition); error (4u entries + u differences + gamma_N sums) * row sum * R,
+  //    counted as 6u + gamma_N.
   double range = 0;
   ws.values.resize(nn * 3);
   for (std::size_t i = 0; i < nn; ++i)
@@ -257,7 +283,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   for (std::size_t c = 0; c < udim; ++c) {
     const std::vector<double>& m = space.column_map(static_cast<int>(c));
     const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
-    const double e = (4 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c)) * range * 1.01;
+    const double e = (6 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c)) * range * 1.01;
     for (std::size_t j = 0; j < 3; ++j) {
       Poly& p = col[c][j];
       p.deg = space.column_degrees(static_cast<int>(c));
@@ -345,7 +371,6 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
 
   // 3. The root: vectors J, N, D_k in the squared space, slot 0 of the leaf pool.
   const std::size_t stride = nvec * s2;
-  ws.work.resize(2 * s2);
   ws.pool.assign(stride, 0.0);
   ws.pool_err.assign(nvec, 0.0);
   const std::array<const Poly*, 2> jn = {&jsq, &n};
@@ -359,6 +384,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   }
   ws.free_slots.clear();
   ws.heap.clear();
+  ws.states.assign(1, b2.root_state());
   // valid lets every subdomain skip its own sign test (the J vector is then a
   // placeholder); invalid means a point with J <= 0, where sj <= 0.
   Bounder bounder(space, s2, v == Validity::valid);
@@ -388,30 +414,42 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   push(0);
 
   QualityBounds out;
-  ws.child.resize(stride);
+  const auto nc = static_cast<std::size_t>(b2.num_children());
+  ws.children.resize(nc * stride);
+  ws.child_states.resize(nc);
   ws.child_err.resize(nvec);
-  auto& child = ws.child;
   auto& child_err = ws.child_err;
+  const double floor = bounder.floor();
   while (!ws.heap.empty()) {
     const Leaf top = ws.heap.front();
     if (up(upper - std::min(top.lower, settled)) <= tol) break;
     if (out.subdivisions >= options.max_subdivisions) break;
+    const std::size_t parent_off = static_cast<std::size_t>(top.slot) * stride;
+    // A fold around a vanishing frame column: the lower bound is at the floor and can
+    // never rise (stuck_at_floor), so more subdivisions could only lower `upper`, which
+    // is bounded below by sj(E) itself; stop, with tolerance_met false (unless upper is
+    // already within the tolerance of the floor).
+    if (top.lower <= floor &&
+        bounder.stuck_at_floor(ws.pool.data() + parent_off, ws.pool_err.data() + top.slot * static_cast<std::ptrdiff_t>(nvec),
+                               b2.vertex_indices()))
+      break;
     std::pop_heap(ws.heap.begin(), ws.heap.end(), cmp);
     ws.heap.pop_back();
     ++out.subdivisions;
     ws.free_slots.push_back(top.slot);
-    const std::size_t parent_off = static_cast<std::size_t>(top.slot) * stride;
     ws.parent_err.assign(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
                          ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
     const auto& parent_err = ws.parent_err;
     // The parent is copied out first: its slot is reused by its children.
     ws.parent.assign(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
                      ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
+    const BisectionState parent_state = ws.states[static_cast<std::size_t>(top.slot)];
     for (std::size_t v = 0; v < nvec; ++v)
-      child_err[v] = up((parent_err[v] + b2.subdivision_rounding() * max_abs(ws.parent.data() + v * s2, s2)) * (1 + 1e-12));
-    for (int q = 0; q < b2.num_children(); ++q) {
-      // All nvec vectors at once: each child's matrix is read once (bit-identical).
-      b2.subdivide_many(q, ws.parent.data(), nvec, child.data(), ws.work.data());
+      child_err[v] = up((parent_err[v] + b2.rounding_relative() * max_abs(ws.parent.data() + v * s2, s2) +
+                         b2.rounding_absolute()) * (1 + 1e-12));
+    // All nvec vectors of all children at once (bit-identical to one at a time).
+    b2.split(ws.parent.data(), nvec, parent_state, ws.children.data(), ws.child_states.data(), ws.work);
+    for (std::size_t q = 0; q < nc; ++q) {
       int slot;
       if (!ws.free_slots.empty()) {
         slot = ws.free_slots.back();
@@ -420,9 +458,13 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
         slot = static_cast<int>(ws.pool_err.size() / nvec);
         ws.pool.resize(ws.pool.size() + stride);
         ws.pool_err.resize(ws.pool_err.size() + nvec);
+        ws.states.resize(ws.states.size() + 1);
       }
-      std::copy(child.begin(), child.end(), ws.pool.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(slot) * stride));
+      std::copy(ws.children.begin() + static_cast<std::ptrdiff_t>(q * stride),
+                ws.children.begin() + static_cast<std::ptrdiff_t>((q + 1) * stride),
+                ws.pool.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(slot) * stride));
       std::copy(child_err.begin(), child_err.end(), ws.pool_err.begin() + slot * static_cast<std::ptrdiff_t>(nvec));
+      ws.states[static_cast<std::size_t>(slot)] = ws.child_states[q];
       push(slot);
     }
   }

@@ -1,8 +1,7 @@
-// Per-type data of the scaled-Jacobian bounds: the exact node-to-column-coefficient maps
-// (rounded once), the squared Bézier space, frames and normalisation.
+// Per-type data of the scaled-Jacobian bounds: the node-to-column-coefficient maps (the
+// Jacobian product path's, rounded once from exact rationals), the squared Bézier space,
+// frames and normalisation.
 #include "analysis/scaled_jacobian_space.hpp"
-
-#include <gmpxx.h>
 
 #include <cmath>
 #include <map>
@@ -11,7 +10,8 @@
 
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
-#include "bezier/bezier_exact.hpp"
+#include "analysis/jacobian_product.hpp"
+#include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
 #include "quadval/scaled_jacobian.hpp"
 
@@ -28,10 +28,9 @@ std::vector<FactorDegree> j_degrees_of(const ElementType& type) {
   return jacobian_factor_degrees(type.family, type.order);
 }
 
-std::vector<const BernsteinSimplex*> squared_factors(const ElementType& type) {
-  std::vector<const BernsteinSimplex*> out;
-  for (const FactorDegree& fd : j_degrees_of(type))
-    out.push_back(&bernstein_simplex(fd.dim, 2 * fd.degree));
+std::vector<FactorDegree> squared_factors(const ElementType& type) {
+  std::vector<FactorDegree> out;
+  for (const FactorDegree& fd : j_degrees_of(type)) out.push_back({fd.dim, 2 * fd.degree});
   return out;
 }
 
@@ -107,14 +106,16 @@ std::vector<Frame> family_frames(ElementFamily f) {
 }  // namespace
 
 int scaled_jacobian_max_order(ElementFamily family) noexcept {
+  // The Jacobian bounds' orders (max_supported_order) except pyramids, whose squared
+  // space has (6r + 1)^3 coefficients per vector: 15625 at r = 4, 166375 at r = 9.
   switch (family) {
-    case ElementFamily::line:
-    case ElementFamily::triangle:
-    case ElementFamily::quadrangle: return 6;
+    case ElementFamily::line: return 10;
+    case ElementFamily::triangle: return 9;
+    case ElementFamily::quadrangle: return 8;
     case ElementFamily::tetrahedron:
     case ElementFamily::prism:
-    case ElementFamily::hexahedron: return 3;
-    case ElementFamily::pyramid: return 2;
+    case ElementFamily::hexahedron: return 4;
+    case ElementFamily::pyramid: return 4;
     default: return 0;
   }
 }
@@ -136,54 +137,12 @@ int factor_of_direction(ElementFamily f, int c) {
   }
 }
 
-using Matrix = std::vector<mpq_class>;  // row-major
-
-// B^n_alpha (|alpha| = n, factor `from`) at the Lagrange points of `to`, exactly:
-// to.size() x from.size().
-Matrix bernstein_values(const BernsteinSimplex& from, const BernsteinSimplex& to) {
-  const int d = from.dim(), n = from.degree();
-  const auto rows = static_cast<std::size_t>(to.size()), cols = static_cast<std::size_t>(from.size());
-  Matrix m(rows * cols);
-  mpz_class fact_n = 1;
-  for (int i = 2; i <= n; ++i) fact_n *= i;
-  for (std::size_t r = 0; r < rows; ++r) {
-    const auto num = to.point_numerators(static_cast<int>(r));
-    for (std::size_t c = 0; c < cols; ++c) {
-      const auto& alpha = from.multi_indices()[c];
-      mpq_class v(fact_n);
-      for (int a = 0; a <= d; ++a) {
-        const auto ua = static_cast<std::size_t>(a);
-        mpz_class fa = 1;
-        for (int i = 2; i <= alpha[ua]; ++i) fa *= i;
-        v /= fa;
-        const mpq_class lambda = mpq_class(num[ua]) / mpq_class(to.point_denominator());
-        for (int e = 0; e < alpha[ua]; ++e) v *= lambda;
-      }
-      v.canonicalize();
-      m[r * cols + c] = v;
-    }
-  }
-  return m;
-}
-
-Matrix multiply(const Matrix& a, const Matrix& b, std::size_t rows, std::size_t inner, std::size_t cols) {
-  Matrix c(rows * cols, mpq_class(0));
-  for (std::size_t r = 0; r < rows; ++r)
-    for (std::size_t k = 0; k < inner; ++k) {
-      const mpq_class& x = a[r * inner + k];
-      if (sgn(x) == 0) continue;
-      for (std::size_t j = 0; j < cols; ++j)
-        if (sgn(b[k * cols + j]) != 0) c[r * cols + j] += x * b[k * cols + j];
-    }
-  return c;
-}
-
 }  // namespace
 
 ScaledJacobianSpace::ScaledJacobianSpace(const ElementType& type)
     : type_(&type),
       j_degrees_(j_degrees_of(type)),
-      squared_(type.family, type.order, squared_factors(type)),
+      squared_(squared_factors(type)),
       frames_(family_frames(type.family)) {
   QV_ASSERT(scaled_jacobian_supported(type), "no scaled Jacobian for " << type.name);
   for (const FactorDegree& fd : j_degrees_) squared_degrees_.push_back({fd.dim, 2 * fd.degree});
@@ -191,71 +150,35 @@ ScaledJacobianSpace::ScaledJacobianSpace(const ElementType& type)
     init_pyramid();
     return;
   }
-  const JacobianSpace& js = jacobian_space(type);
+  // The columns' control points are the Jacobian product path's derivative maps
+  // (jacobian_product.hpp: scaled rows G^_k = mult(k) G_k, rounded to nearest from the
+  // exact rationals, and 1 / mult(k) rounded to nearest), already in the columns' native
+  // spaces and in Gmsh's coordinates; no exact inverse of a J-space collocation matrix is
+  // needed (it is cubic in the J factor's size: 220 for a tetrahedron of order 4).
+  const JacobianProduct* jp = jacobian_space(type).product();
+  QV_ASSERT(jp != nullptr, "no product path for " << type.name);
+  const ProductTables tables = jp->tables();
+  const ProductTables::MapTables& curved = tables.maps[static_cast<std::size_t>(SampleMap::curved)];
   const auto nn = static_cast<std::size_t>(type.num_nodes);
-  const std::size_t nf = j_degrees_.size();
+  QV_ASSERT(curved.num_nodes == type.num_nodes, "product map of " << type.name << " reads " << curved.num_nodes << " nodes");
   for (int c = 0; c < type.dim; ++c) {
     const auto uc = static_cast<std::size_t>(c);
-    // Native degrees, and per factor the exact map from the Jacobian space's samples to
-    // the column's Bézier coefficients: A_f = T_native * (Bernstein_n at the native
-    // points) * T_n (eq. 18 both ends).
-    std::vector<Matrix> a(nf);
-    std::vector<std::size_t> s_in(nf), s_out(nf);
-    for (std::size_t f = 0; f < nf; ++f) {
+    for (std::size_t f = 0; f < j_degrees_.size(); ++f) {
       const int m = type.order - (factor_of_direction(type.family, c) == static_cast<int>(f) ? 1 : 0);
       col_degrees_[uc].push_back({j_degrees_[f].dim, m});
-      const BernsteinSimplex& jf = bernstein_simplex(j_degrees_[f].dim, j_degrees_[f].degree);
-      const BernsteinSimplex& nat = bernstein_simplex(j_degrees_[f].dim, m);
-      s_in[f] = static_cast<std::size_t>(jf.size());
-      s_out[f] = static_cast<std::size_t>(nat.size());
-      const Matrix e = bernstein_values(jf, nat);
-      const Matrix et = multiply(e, jf.exact().to_bezier, s_out[f], s_in[f], s_in[f]);
-      a[f] = multiply(nat.exact().to_bezier, et, s_out[f], s_out[f], s_in[f]);
     }
-    // Apply A_0 x A_1 x A_2 to every node's gradient column, factor by factor.
-    const std::vector<mpq_class>& g = js.exact_gradient(c);
-    std::size_t out_size = 1;
-    for (std::size_t f = 0; f < nf; ++f) out_size *= s_out[f];
-    col_size_[uc] = static_cast<int>(out_size);
-    std::vector<mpq_class> exact(out_size * nn);
-    for (std::size_t i = 0; i < nn; ++i) {
-      std::size_t in_size = 1;
-      for (std::size_t f = 0; f < nf; ++f) in_size *= s_in[f];
-      std::vector<mpq_class> t(in_size);
-      for (std::size_t k = 0; k < in_size; ++k) t[k] = g[k * nn + i];
-      std::size_t inner = 1;
-      for (std::size_t f = 0; f < nf; ++f) {
-        std::size_t outer = 1;
-        for (std::size_t h = f + 1; h < nf; ++h) outer *= s_in[h];
-        std::vector<mpq_class> u(inner * s_out[f] * outer, mpq_class(0));
-        for (std::size_t b = 0; b < outer; ++b)
-          for (std::size_t r = 0; r < s_out[f]; ++r)
-            for (std::size_t m = 0; m < s_in[f]; ++m) {
-              const mpq_class& w = a[f][r * s_in[f] + m];
-              if (sgn(w) == 0) continue;
-              for (std::size_t x = 0; x < inner; ++x) {
-                const mpq_class& v = t[x + inner * (m + s_in[f] * b)];
-                if (sgn(v) != 0) u[x + inner * (r + s_out[f] * b)] += w * v;
-              }
-            }
-        t = std::move(u);
-        inner *= s_out[f];
-      }
-      for (std::size_t r = 0; r < out_size; ++r) exact[r * nn + i] = t[r];
-    }
-    col_map_[uc].resize(out_size * nn);
-    double worst = 0;
-    for (std::size_t r = 0; r < out_size; ++r) {
-      double sum = 0;
-      for (std::size_t i = 0; i < nn; ++i) {
-        const double d = exact[r * nn + i].get_d();  // truncation: within 2u relative
-        col_map_[uc][r * nn + i] = d;
-        sum += std::abs(d);
-      }
-      worst = std::max(worst, sum);
-    }
-    // |exact| <= |rounded| (1 + 2u); the double sum of nn terms within gamma_nn.
-    col_row_sum_[uc] = next_up(worst * (1 + 4 * kUnit) * (1 + rounding_gamma(static_cast<int>(nn))));
+    const std::vector<double>& g = curved.matrix[uc];
+    const std::vector<double>& inv = tables.deriv_inv_mult[uc];
+    const std::size_t rows = inv.size();
+    QV_ASSERT(rows == static_cast<std::size_t>(bernstein_space_size(col_degrees_[uc])) && g.size() == rows * nn,
+              "column space of " << type.name);
+    col_size_[uc] = static_cast<int>(rows);
+    // Entry G^_ki * fl(1 / mult(k)), rounded: within 3u (1 + 3u) of the exact G_ki.
+    col_map_[uc].resize(rows * nn);
+    for (std::size_t r = 0; r < rows; ++r)
+      for (std::size_t i = 0; i < nn; ++i) col_map_[uc][r * nn + i] = g[r * nn + i] * inv[r];
+    // Covers sum_i |exact G_ki| (the product path's own bound).
+    col_row_sum_[uc] = curved.row_sum[uc];
   }
 
   double s = 1;

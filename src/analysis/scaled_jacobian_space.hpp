@@ -4,11 +4,23 @@
 // (native) degrees, the Bézier space of the squared quantities N and D_k (the Jacobian
 // space's factors at twice their degree), the frames and the normalisation. Built once
 // per type, immutable, shared by all threads. Internal to src/analysis.
+//
+// The squared space is subdivided by edge bisection (bezier/bernstein_bisection.hpp),
+// not by BezierBasis's dense midpoint-split matrices: at the orders the Jacobian bounds
+// reach, its simplex factors are far beyond what dense matrices allow (tetrahedron of
+// order 4: degree 18, 1330 coefficients, 8 x 1330^2 doubles = 113 MB of matrices; triangle
+// of order 9: degree 32, 561), and bisection costs fewer operations even where they fit
+// (a split of the degree-12 squared factor of a cubic tetrahedron: ~15 thousand averages
+// per vector against 1.7 million multiply-adds). N and D_k are formed once per element,
+// then only subdivided: recomputing them by products on every subdomain (subdividing the
+// columns instead) would cost a Bernstein product of the degree-2n spaces per vector and
+// subdomain, more than the bisection of the product itself.
 #include <array>
 #include <span>
 #include <vector>
 
 #include "analysis/jacobian_space.hpp"
+#include "bezier/bernstein_bisection.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -29,7 +41,7 @@ class ScaledJacobianSpace {
   /// The space of J (jacobian_factor_degrees) and of N, D_k (twice those degrees).
   const std::vector<FactorDegree>& j_degrees() const noexcept { return j_degrees_; }
   const std::vector<FactorDegree>& squared_degrees() const noexcept { return squared_degrees_; }
-  const BezierBasis& squared() const noexcept { return squared_; }
+  const BernsteinBisection& squared() const noexcept { return squared_; }
   const std::vector<Frame>& frames() const noexcept { return frames_; }
   /// s of the definition and a guaranteed enclosure s_lo <= s <= s_hi.
   double s_lo() const noexcept { return s_lo_; }
@@ -42,8 +54,9 @@ class ScaledJacobianSpace {
   const std::vector<FactorDegree>& column_degrees(int c) const noexcept { return col_degrees_[static_cast<std::size_t>(c)]; }
   int column_size(int c) const noexcept { return col_size_[static_cast<std::size_t>(c)]; }
   /// Its Bézier coefficients = column_map(c) * (x_i - x_0) per axis: row-major
-  /// column_size(c) x #nodes, each entry within 2u relative of the exact rational
-  /// (computed once in exact arithmetic from the exact shape-function gradients).
+  /// column_size(c) x #nodes, each entry within 4u relative of the exact rational
+  /// (the Jacobian product path's scaled derivative map times its rounded 1 / mult(k);
+  /// pyramids: pyramid_column_maps, within u).
   const std::vector<double>& column_map(int c) const noexcept { return col_map_[static_cast<std::size_t>(c)]; }
   /// max over rows of sum_i |exact entry|, rounded up.
   double column_row_sum(int c) const noexcept { return col_row_sum_[static_cast<std::size_t>(c)]; }
@@ -53,7 +66,7 @@ class ScaledJacobianSpace {
 
   const ElementType* type_;
   std::vector<FactorDegree> j_degrees_, squared_degrees_;
-  BezierBasis squared_;
+  BernsteinBisection squared_;
   std::vector<Frame> frames_;
   std::array<std::vector<FactorDegree>, 3> col_degrees_;
   std::array<int, 3> col_size_{0, 0, 0};

@@ -10,6 +10,7 @@
 #include <iomanip>
 #include <random>
 
+#include "analysis/mu_space.hpp"
 #include "mu_test_util.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -22,10 +23,15 @@ namespace {
 using test::affine_ideal_element;
 using test::pointwise_mu;
 
+// The types handled before issue 5 (2D to order 6, 3D to mu_certificate_max_order); the
+// higher orders are tested in mu_high_order_test.cpp (smooth warps instead of node noise,
+// which makes elements of orders 8-9 invalid at any visible amplitude).
 std::vector<const ElementType*> mu_types() {
   std::vector<const ElementType*> out;
   for (const ElementType& t : element_types())
-    if (t.family != ElementFamily::line && t.has_lagrange_basis && mu_supported(t)) out.push_back(&t);
+    if (t.family != ElementFamily::line && t.has_lagrange_basis && mu_supported(t) &&
+        t.order <= (t.dim == 2 ? 6 : mu_certificate_max_order(t.family)))
+      out.push_back(&t);
   return out;
 }
 
@@ -215,9 +221,9 @@ TEST(MuBounds, LinesAreOneWhenValid) {
 }
 
 TEST(MuBounds, UnsupportedTypesAreReported) {
-  EXPECT_FALSE(mu_supported(*find_element_type(118)));  // pyramid of order 3
-  EXPECT_FALSE(mu_supported(*find_element_type(15)));   // point
-  EXPECT_THROW(mu_bounds(*find_element_type(118), std::vector<double>(90, 0.0), QualityOptions{}),
+  EXPECT_FALSE(mu_supported(*find_element_type(94)));  // hexahedron of order 5
+  EXPECT_FALSE(mu_supported(*find_element_type(15)));  // point
+  EXPECT_THROW(mu_bounds(*find_element_type(94), std::vector<double>(648, 0.0), QualityOptions{}),
                InternalError);
 }
 

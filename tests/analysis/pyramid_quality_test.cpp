@@ -103,9 +103,11 @@ Eigen::Matrix3d rotation(double a, double b) {
       .toRotationMatrix();
 }
 
-TEST(MuPyramid, SupportedForOrdersOneAndTwo) {
-  for (const ElementType* t : pyramid_types()) EXPECT_TRUE(mu_supported(*t)) << t->name;
-  EXPECT_FALSE(mu_supported(*find_element_type(118)));  // order 3: not handled
+TEST(MuPyramid, SupportedForEveryOrderOfTheJacobianBounds) {
+  for (const ElementType& t : element_types())
+    if (t.family == ElementFamily::pyramid && t.has_lagrange_basis && t.order >= 1)
+      EXPECT_EQ(mu_supported(t), jacobian_bounds_supported(t)) << t.name;
+  EXPECT_TRUE(mu_supported(*find_element_type(118)));  // order 3
 }
 
 TEST(MuPyramid, IdealPyramidAndItsSimilaritiesHaveMuOne) {
@@ -320,9 +322,11 @@ double corner_sj(const std::vector<double>& x) {
   return best;
 }
 
-TEST(ScaledJacobianPyramid, SupportedForOrdersOneAndTwo) {
+TEST(ScaledJacobianPyramid, SupportedToOrderFour) {
   for (const ElementType* t : pyramid_types()) EXPECT_TRUE(scaled_jacobian_supported(*t)) << t->name;
-  EXPECT_FALSE(scaled_jacobian_supported(*find_element_type(118)));
+  EXPECT_TRUE(scaled_jacobian_supported(*find_element_type(118)));   // order 3
+  EXPECT_TRUE(scaled_jacobian_supported(*find_element_type(119)));   // order 4
+  EXPECT_FALSE(scaled_jacobian_supported(*find_element_type(120)));  // order 5
 }
 
 TEST(ScaledJacobianPyramid, ClosedFormsOnStraightPyramids) {

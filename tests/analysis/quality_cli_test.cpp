@@ -181,27 +181,33 @@ TEST_F(QualityCli, InvertedElementExitsOneWithNegativeScaledJacobian) {
 }
 
 TEST_F(QualityCli, UnsupportedTypesAreReportedAsSkipped) {
-  // An order-3 pyramid (mu and the scaled Jacobian handle pyramids up to order 2): validity
-  // is checked, both measures skip it and say so; the exit code is the validity's.
-  const ElementType& p3 = *find_element_type(118);
+  // An order-5 pyramid: validity and mu are computed (mu covers every type of the Jacobian
+  // bounds), the scaled Jacobian (pyramids up to order 4) skips it and says so; the exit
+  // code is the validity's.
+  const ElementType& p5 = *find_element_type(120);
   std::vector<std::array<double, 3>> nodes;
   std::vector<int> conn;
-  for (const auto& r : reference_nodes(p3)) {
+  for (const auto& r : reference_nodes(p5)) {
     nodes.push_back({r[0], r[1], r[2]});
     conn.push_back(static_cast<int>(nodes.size()));
   }
-  const std::string mesh = (dir_ / "pyramid_o3.msh").string();
-  write_msh(mesh, nodes, 118, {conn});
+  const std::string mesh = (dir_ / "pyramid_o5.msh").string();
+  write_msh(mesh, nodes, 120, {conn});
   const fs::path csv = dir_ / "p.csv";
   const CliRun v = run_cli("check " + mesh + " -q");
   const CliRun r = run_cli("check " + mesh + " --measure all -o " + csv.string());
+  EXPECT_EQ(v.code, 0) << v.output;
   EXPECT_EQ(r.code, v.code) << r.output;
   EXPECT_NE(r.output.find("skipped for scaled Jacobian"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("skipped for mu"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("skipped for mu"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("computed 0, skipped 1"), std::string::npos) << r.output;
   for (const auto& row : read_csv(csv)) {
     EXPECT_EQ(row.at("sj_lower"), "nan");
-    EXPECT_EQ(row.at("mu_lower"), "nan");
+    // Gmsh's reference pyramid (apex height 1) is the ideal one (equilateral faces, apex
+    // height sqrt 2) squashed along z: W = diag(1, 1, 1/sqrt 2), mu = 1/sqrt 2.
+    EXPECT_LE(std::stod(row.at("mu_lower")), std::sqrt(0.5) + 1e-12);
+    EXPECT_GE(std::stod(row.at("mu_upper")), std::sqrt(0.5) - 1e-12);
+    EXPECT_LE(std::stod(row.at("mu_upper")) - std::stod(row.at("mu_lower")), 1e-2);
   }
 }
 

@@ -1,0 +1,168 @@
+// Edge bisection of tensor-product Bernstein polynomials by de Casteljau at 1/2
+// (bernstein_bisection.hpp).
+#include "bezier/bernstein_bisection.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kUnit = 0x1p-53;
+constexpr double kHalfDenormMin = 0x1p-1074;  // bound on the error of a subnormal halving
+
+}  // namespace
+
+BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
+    : factors_(std::move(factors)) {
+  QV_ASSERT(!factors_.empty() && factors_.size() <= 3, factors_.size() << " factors");
+  std::array<std::vector<std::array<int, 4>>, 3> alphas;
+  std::array<int, 3> sizes{1, 1, 1};
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    const FactorDegree fd = factors_[f];
+    QV_ASSERT(fd.dim >= 1 && fd.dim <= 3 && fd.degree >= 0, "factor " << fd.dim << "/" << fd.degree);
+    alphas[f] = simplex_multi_indices(fd.dim, fd.degree);
+    sizes[f] = static_cast<int>(alphas[f].size());
+    stride_[f] = size_;
+    size_ *= sizes[f];
+    dim_ += fd.dim;
+  }
+  QV_ASSERT(dim_ <= 3, "dimension " << dim_);
+
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    // Offsets of every combination of the other factors' indices.
+    for (int g = 0; g < size_; ++g)
+      if ((g / stride_[f]) % sizes[f] == 0) bases_[f].push_back(g);
+    const int d = factors_[f].dim;
+    const int n = factors_[f].degree;
+    std::map<std::array<int, 4>, int> local_of;
+    for (int i = 0; i < sizes[f]; ++i) local_of[alphas[f][static_cast<std::size_t>(i)]] = i;
+    for (int a = 0; a <= d; ++a)
+      for (int b = 0; b <= d; ++b) {
+        if (a == b) continue;
+        // One line per multi-index with alpha_b = 0, walking alpha_a -> alpha_b.
+        EdgeLines& el = lines_[f][static_cast<std::size_t>(a * 4 + b)];
+        el.first.push_back(0);
+        for (const auto& alpha : alphas[f]) {
+          if (alpha[static_cast<std::size_t>(b)] != 0) continue;
+          std::array<int, 4> beta = alpha;
+          const int m = alpha[static_cast<std::size_t>(a)];
+          for (int i = 0; i <= m; ++i) {
+            beta[static_cast<std::size_t>(a)] = m - i;
+            beta[static_cast<std::size_t>(b)] = i;
+            el.index.push_back(local_of.at(beta));
+          }
+          el.first.push_back(static_cast<int>(el.index.size()));
+        }
+      }
+    // Maubach's start (tag d). Triangles: (v1, v0, v2), so that the first edge is the
+    // hypotenuse. Tetrahedra: (v0, v1, v2, v3), the image of the Kuhn simplex
+    // (0, e1, e1 + e2, e1 + e2 + e3) under a linear map; measured on
+    // warped_tetrahedron_o3_N6_a0.25.msh (--tol 1e-2, 1000 splits): 8 elements short of
+    // the tolerance (the 8 folds of stuck_at_floor) against 11 when starting from
+    // (v1, v0, v2, v3) and 22 with longest-edge bisection.
+    root_.tag[f] = static_cast<std::int8_t>(d);
+    root_.order[f] = d == 1   ? std::array<std::int8_t, 4>{0, 1, 0, 0}
+                     : d == 2 ? std::array<std::int8_t, 4>{1, 0, 2, 0}
+                              : std::array<std::int8_t, 4>{0, 1, 2, 3};
+    // d bisections of degree n per split.
+    rounding_relative_ += d * n * kUnit;
+    rounding_absolute_ += d * n * kHalfDenormMin;
+  }
+  // The bound above counts one rounding per average; multiplying by 1 + 1e-12 covers
+  // the rounding of this bound's own products.
+  rounding_relative_ *= 1 + 1e-12;
+  rounding_absolute_ *= 1 + 1e-12;
+
+  // Vertex coefficients: alpha = n e_a in every factor.
+  std::array<std::vector<int>, 3> vertex_local;
+  for (std::size_t f = 0; f < 3; ++f) {
+    if (f >= factors_.size()) {
+      vertex_local[f] = {0};
+      continue;
+    }
+    for (int i = 0; i < sizes[f]; ++i)
+      for (int a = 0; a <= factors_[f].dim; ++a)
+        if (alphas[f][static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] == factors_[f].degree) {
+          vertex_local[f].push_back(i);
+          break;
+        }
+  }
+  for (int i2 : vertex_local[2])
+    for (int i1 : vertex_local[1])
+      for (int i0 : vertex_local[0]) vertex_indices_.push_back(i0 + stride_[1] * i1 + stride_[2] * i2);
+  std::sort(vertex_indices_.begin(), vertex_indices_.end());
+}
+
+void BernsteinBisection::bisect(const double* in, std::size_t f, int a, int b, double* keep_a,
+                                double* keep_b) const {
+  const EdgeLines& el = lines(f, a, b);
+  const int stride = stride_[f];
+  std::array<double, 128> w{};
+  for (int base : bases_[f])
+    for (std::size_t l = 0; l + 1 < el.first.size(); ++l) {
+      const int* idx = el.index.data() + el.first[l];
+      const int m = el.first[l + 1] - el.first[l] - 1;
+      QV_ASSERT(m < static_cast<int>(w.size()), "line of degree " << m);
+      for (int i = 0; i <= m; ++i) w[static_cast<std::size_t>(i)] = in[base + stride * idx[i]];
+      // Level r of the de Casteljau triangle: w[0] is the keep-a child's coefficient with
+      // r midpoints, w[m - r] the keep-b child's with m - r copies of b.
+      keep_a[base + stride * idx[0]] = w[0];
+      keep_b[base + stride * idx[m]] = w[static_cast<std::size_t>(m)];
+      for (int r = 1; r <= m; ++r) {
+        for (int j = 0; j + r <= m; ++j)
+          w[static_cast<std::size_t>(j)] = (w[static_cast<std::size_t>(j)] + w[static_cast<std::size_t>(j + 1)]) * 0.5;
+        keep_a[base + stride * idx[r]] = w[0];
+        keep_b[base + stride * idx[m - r]] = w[static_cast<std::size_t>(m - r)];
+      }
+    }
+}
+
+void BernsteinBisection::split(const double* parent, std::size_t count, const BisectionState& state,
+                               double* children, BisectionState* states,
+                               std::vector<double>& scratch) const {
+  const auto block = static_cast<std::size_t>(size_) * count;
+  const auto nc = static_cast<std::size_t>(num_children());
+  // Pieces live in `children` (final layout) and `scratch` (the previous level), swapped
+  // level by level; the last level must land in `children`.
+  scratch.resize(block * nc);
+  std::size_t levels = 0;
+  for (const FactorDegree& fd : factors_) levels += static_cast<std::size_t>(fd.dim);
+  double* cur = (levels % 2 == 0) ? children : scratch.data();
+  double* nxt = (levels % 2 == 0) ? scratch.data() : children;
+  std::copy(parent, parent + block, cur);
+  states[0] = state;
+  std::size_t pieces = 1;
+  for (std::size_t f = 0; f < factors_.size(); ++f) {
+    for (int level = 0; level < factors_[f].dim; ++level) {
+      // Descending: piece p is read before 2p and 2p + 1 are written.
+      for (std::size_t p = pieces; p-- > 0;) {
+        const BisectionState s = states[p];
+        const auto& o = s.order[f];
+        const int k = s.tag[f];
+        const int a = o[0], b = o[static_cast<std::size_t>(k)];
+        for (std::size_t v = 0; v < count; ++v)
+          bisect(cur + p * block + v * static_cast<std::size_t>(size_), f, a, b,
+                 nxt + (2 * p) * block + v * static_cast<std::size_t>(size_),
+                 nxt + (2 * p + 1) * block + v * static_cast<std::size_t>(size_));
+        const auto tag = static_cast<std::int8_t>(k > 1 ? k - 1 : factors_[f].dim);
+        BisectionState first = s, second = s;
+        first.tag[f] = tag;   // (x_0..x_{k-1}, z, x_{k+1}..): z took x_k's slot b
+        second.tag[f] = tag;  // (x_1..x_k, z, x_{k+1}..): z took x_0's slot a
+        for (int i = 0; i < k; ++i) second.order[f][static_cast<std::size_t>(i)] = o[static_cast<std::size_t>(i + 1)];
+        second.order[f][static_cast<std::size_t>(k)] = static_cast<std::int8_t>(a);
+        states[2 * p] = first;
+        states[2 * p + 1] = second;
+      }
+      pieces *= 2;
+      std::swap(cur, nxt);
+    }
+  }
+  QV_ASSERT(cur == children && pieces == nc, "bisection levels");
+  for (std::size_t q = 0; q < nc; ++q) states[q].depth = state.depth + 1;
+}
+
+}  // namespace quadval
