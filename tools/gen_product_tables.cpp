@@ -26,7 +26,8 @@ using quadval::ElementType;
 
 // Which types get tables: the Lagrange types of the product path with at most 64 nodes
 // (hexahedra and prisms up to order 3, tetrahedra 4, pyramids 4, triangles 9, quadrangles
-// 7, lines 10). Larger ones (order-4 hexahedra: 37,500 entries) keep the exact path.
+// 7, incomplete triangles and quadrangles 10, lines 10). Larger ones (order-4 hexahedra:
+// 37,500 entries) keep the exact path.
 // Pyramids matter most: their exact set-up (Vandermonde inverse, monomial-to-Bernstein
 // maps in GMP) took 1.4 ms for the 14-node pyramid, against ~50 us from tables. Their
 // serendipity types of orders 5-8 have few nodes but J spaces of up to 12,672

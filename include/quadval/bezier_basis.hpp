@@ -133,14 +133,13 @@ struct FactorDegree {
 };
 std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int order);
 
-/// Highest geometric order whose Jacobian space we build, per family: lines 10 (every
-/// order Gmsh defines), triangles 9, quadrangles 8, tetrahedra 4, prisms and hexahedra 4.
+/// Highest geometric order whose Jacobian space we build, per family: lines, triangles and
+/// quadrangles 10 (every order Gmsh defines), tetrahedra 4, prisms and hexahedra 4.
 /// The Jacobian coefficients come from Bernstein products of the geometry's control
 /// points (src/analysis/jacobian_product.hpp), not from the J space's ill-conditioned
-/// conversion; the limits are the a priori rounding bound of the geometry's equispaced
-/// conversion (2D beyond these orders: bounds too wide to decide random curved elements)
-/// and memory (tetrahedra of order 5: a 455-coefficient factor, 8 x 455^2 subdivision
-/// entries). Pyramids: kPyramidMaxOrder (Paper IV, sampled). 0 for other families.
+/// conversion; the 3D limits are memory (tetrahedra of order 5: a 455-coefficient factor,
+/// 8 x 455^2 subdivision entries) and time. Pyramids: kPyramidMaxOrder (Paper IV,
+/// sampled). 0 for other families.
 int max_supported_order(ElementFamily family) noexcept;
 
 /// The Bézier basis of the Jacobian determinant space of (family, order p): a tensor

@@ -44,7 +44,8 @@
 ///   enclosure (closed form 2x2; 3x3: trigonometric approximation certified by Sylvester's
 ///   criterion, else Gershgorin at approximate eigenvectors with Ostrowski's theorem). It
 ///   converges quadratically under subdivision and settles almost every subdomain. Only in
-///   an element split 24 times already, and where that bound falls short, the exact
+///   an element split 24 times already (types with the certificate only: order <=
+///   mu_certificate_max_order), and where that bound falls short, the exact
 ///   certificate: the largest r (bisection) with R >= r, R = mu_pw^2:
 ///   2D (Paper V §4): a^2 = q^2 / (s^2 + t^2) >= rho from the control values (§3.1), then
 ///      R >= (sqrt rho - 1) / (sqrt rho + 1);
@@ -62,7 +63,7 @@
 /// upper: the minimum over the corners of all subdomains of an upper bound of mu_pw there
 ///   (Rayleigh quotients of W at approximate eigenvectors of W^T W, enclosed in interval
 ///   fashion: lambda_min <= |W v|^2 / |v|^2 <= lambda_max for any v).
-/// Pyramids (orders 1 and 2). Bergot's map is rational in (xi, eta, zeta), but in the cube
+/// Pyramids (every order). Bergot's map is rational in (xi, eta, zeta), but in the cube
 ///   coordinates u = (xi/t + 1)/2, v = (eta/t + 1)/2, t = 1 - zeta (bezier/pyramid_basis.hpp)
 ///   the columns X_xi, X_eta, X_zeta of J_p (Gmsh's directions) are polynomials of degrees
 ///   (r-1, r, r-1), (r, r-1, r-1), (r, r, r-1) (src/analysis/pyramid_space.hpp): W is a
@@ -88,10 +89,11 @@
 
 namespace quadval {
 
-/// True when mu_bounds handles this type: Lagrange lines (any order), triangles and
-/// quadrangles up to order 6, tetrahedra up to order 3, prisms, hexahedra and pyramids up
-/// to order 2 (complete and incomplete), within what jacobian_bounds_supported() accepts.
-/// The limit is the cost of the degree-12n certificate of 3D elements.
+/// True when mu_bounds handles this type: every type jacobian_bounds_supported() accepts
+/// (lines, triangles and quadrangles to order 10, tetrahedra, prisms and hexahedra to 4,
+/// pyramids to 9; complete and incomplete). The exact degree-12n certificate exists only up
+/// to mu_certificate_max_order (src/analysis/mu_space.hpp: tetrahedra 3, prisms,
+/// hexahedra and pyramids 2); above, the control-matrix bound alone bounds mu.
 bool mu_supported(const ElementType& type) noexcept;
 
 /// Certified bounds of mu(E) for one element. Thread-safe (thread_local scratch) and

@@ -89,7 +89,7 @@ namespace quadval {
 bool scaled_jacobian_supported(const ElementType& type) noexcept;
 
 /// Highest order handled per family: the Jacobian bounds' orders (max_supported_order:
-/// lines 10, triangles 9, quadrangles 8, tetrahedra, prisms and hexahedra 4) and pyramids
+/// lines, triangles and quadrangles 10, tetrahedra, prisms and hexahedra 4) and pyramids
 /// 4 (columns of degree r per cube axis, N and D_k of degree 6r: 15625 coefficients per
 /// vector at r = 4, 166375 at the Jacobian's r = 9); 0 for the other families. N and D_k
 /// have twice the degree of J (a tetrahedron of order 4: 1330 coefficients per vector, a

@@ -135,8 +135,8 @@ std::array<double, 9> ideal_inverse_of(ElementFamily f) {
 int mu_max_order(ElementFamily family) noexcept {
   switch (family) {
     case ElementFamily::line: return 10;
-    case ElementFamily::triangle: return 9;
-    case ElementFamily::quadrangle: return 8;
+    case ElementFamily::triangle: return 10;
+    case ElementFamily::quadrangle: return 10;
     case ElementFamily::tetrahedron:
     case ElementFamily::prism:
     case ElementFamily::hexahedron: return 4;
@@ -147,8 +147,8 @@ int mu_max_order(ElementFamily family) noexcept {
 
 int mu_certificate_max_order(ElementFamily family) noexcept {
   switch (family) {
-    case ElementFamily::triangle: return 9;
-    case ElementFamily::quadrangle: return 8;
+    case ElementFamily::triangle: return 10;
+    case ElementFamily::quadrangle: return 10;
     case ElementFamily::tetrahedron: return 3;  // 12 n = 24: 2925 coefficients
     case ElementFamily::prism:
     case ElementFamily::hexahedron:

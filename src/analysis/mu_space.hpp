@@ -17,7 +17,7 @@
 namespace quadval {
 
 /// Highest order of each family for which mu is bounded: the Jacobian engine's
-/// max_supported_order for every family (triangles 9, quadrangles 8, tetrahedra 4, prisms
+/// max_supported_order for every family (triangles and quadrangles 10, tetrahedra 4, prisms
 /// and hexahedra 4, pyramids 9; lines 10: mu is 1 or 0); 0 for other families. Above
 /// mu_certificate_max_order the control-matrix bound of mu_control_bound.hpp bounds every
 /// subdomain alone: it is certified on its own and needs only W's space and the degree-2n
@@ -30,8 +30,9 @@ namespace quadval {
 int mu_max_order(ElementFamily family) noexcept;
 
 /// Highest order of each family whose MuSpace also holds the exact certificate of
-/// mu_metric.hpp (product tables up to degree 4n in 2D, 12n in 3D): triangles 9 and
-/// quadrangles 8 (2D needs degree 4n only: <= 0.09 s, 3 MB at triangle order 9),
+/// mu_metric.hpp (product tables up to degree 4n in 2D, 12n in 3D): triangles and
+/// quadrangles 10 (2D needs degree 4n only: 0.16 s at triangle order 10, 0.09 s at
+/// quadrangle order 10),
 /// tetrahedra 3, prisms, hexahedra and pyramids 2. Above, measured: the tetrahedron of
 /// order 4 needs 6.8 s and 207 MB for its tables; prisms and hexahedra of order 3 build
 /// theirs in 0.3 s, but one (6n, 6n) product takes 4.4 ms resp. 14 ms (hexahedron of order

@@ -110,8 +110,8 @@ int scaled_jacobian_max_order(ElementFamily family) noexcept {
   // space has (6r + 1)^3 coefficients per vector: 15625 at r = 4, 166375 at r = 9.
   switch (family) {
     case ElementFamily::line: return 10;
-    case ElementFamily::triangle: return 9;
-    case ElementFamily::quadrangle: return 8;
+    case ElementFamily::triangle: return 10;
+    case ElementFamily::quadrangle: return 10;
     case ElementFamily::tetrahedron:
     case ElementFamily::prism:
     case ElementFamily::hexahedron: return 4;

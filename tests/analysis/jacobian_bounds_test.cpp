@@ -19,6 +19,7 @@ namespace {
 using test::dense_points;
 using test::jacobian_at;
 using test::random_element;
+using test::smooth_random_element;
 
 // min over x in [0,1] of a x^2 + b x + c (eq. 7).
 double minq(double a, double b, double c) {
@@ -129,8 +130,11 @@ TEST_P(DenseSamplingTest, SampledExtremaInsideBounds) {
   measure.rel_tol = 1e-2;
   int kinds[3] = {0, 0, 0};
   for (int e = 0; e < count; ++e) {
+    // Above order 6 independent noise at the nodes makes nearly every element invalid
+    // (the equispaced interpolant amplifies it): curve those by a smooth field instead.
     const double amp = 0.04 * (1 + e % 6) / type.order;  // node spacing shrinks as 1/p
-    const auto x = random_element(type, amp, rng);
+    const auto x = type.order > 6 ? smooth_random_element(type, 0.05 * (1 + e % 6), rng)
+                                  : random_element(type, amp, rng);
     const bool planar = type.dim == 2;
     double smin = INFINITY, smax = -INFINITY, scale = 0;
     for (const auto& p : pts) {
@@ -177,7 +181,7 @@ TEST(JacobianBoundsKnown, AffineElementsHaveConstantJacobian) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   BoundsWorkspace ws;
-  for (const ElementType* type : test::analysed_types(6, 4)) {
+  for (const ElementType* type : test::analysed_types(10, 4)) {
     double a[3][3] = {{2, 0.3, 0.1}, {-0.2, 1.5, 0.4}, {0.1, 0.2, 1.2}};
     if (type->dim == 2) a[0][2] = a[1][2] = a[2][0] = a[2][1] = 0, a[2][2] = 1;
     const auto ref = reference_nodes(*type);

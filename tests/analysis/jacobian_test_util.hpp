@@ -44,6 +44,29 @@ inline std::vector<double> random_element(const ElementType& type, double amplit
   return x;
 }
 
+/// An element of `type` curved the way a mesher curves one: random_element's random affine
+/// map (without its node noise), then a smooth displacement x_c += amplitude sin(k_c . xi +
+/// phase_c) per coordinate c (2D: x and y), xi the reference node, k_c in [-2, 2]^3. At high
+/// orders such elements stay valid for small amplitudes where independent noise at each node
+/// does not: the equispaced interpolant amplifies it (at order 10 every such element was
+/// invalid).
+inline std::vector<double> smooth_random_element(const ElementType& type, double amplitude,
+                                                 std::mt19937& rng) {
+  std::uniform_real_distribution<double> w(-2, 2), phase(0, 6.283);
+  std::vector<double> x = random_element(type, 0.0, rng);
+  double k[3][3], ph[3];
+  for (int c = 0; c < 3; ++c) {
+    for (double& v : k[c]) v = w(rng);
+    ph[c] = phase(rng);
+  }
+  const auto ref = reference_nodes(type);
+  for (std::size_t i = 0; i < ref.size(); ++i)
+    for (int c = 0; c < (type.dim == 2 ? 2 : 3); ++c)
+      x[3 * i + static_cast<std::size_t>(c)] +=
+          amplitude * std::sin(k[c][0] * ref[i][0] + k[c][1] * ref[i][1] + k[c][2] * ref[i][2] + ph[c]);
+  return x;
+}
+
 /// J at a reference point (Gmsh coordinates), from the shape-function gradients; the 1D
 /// and 2D conventions of jacobian_bounds.hpp (planar 2D: n = +z).
 inline double jacobian_at(const LagrangeBasis& basis, const std::vector<double>& x,

@@ -58,26 +58,6 @@ std::vector<const ElementType*> new_types() {
   return out;
 }
 
-// A random curved element: test::random_element's random affine map, then a smooth warp
-// x + a sin(k . xi + phi) per coordinate (xi the reference node), curved like meshed
-// geometry at every order (independent noise on the nodes of an order-9 element makes
-// it invalid at any visible amplitude: tests/analysis/pyramid_jacobian_test.cpp).
-std::vector<double> warped_element(const ElementType& t, double amplitude, std::mt19937& rng) {
-  std::uniform_real_distribution<double> w(-2, 2), phase(0, 6.283);
-  auto x = test::random_element(t, 0.0, rng);
-  double k[3][3], ph[3];
-  for (int c = 0; c < 3; ++c) {
-    for (double& v : k[c]) v = w(rng);
-    ph[c] = phase(rng);
-  }
-  const auto ref = reference_nodes(t);
-  for (std::size_t i = 0; i < ref.size(); ++i)
-    for (int c = 0; c < (t.dim == 2 ? 2 : 3); ++c)
-      x[3 * i + static_cast<std::size_t>(c)] +=
-          amplitude * std::sin(k[c][0] * ref[i][0] + k[c][1] * ref[i][1] + k[c][2] * ref[i][2] + ph[c]);
-  return x;
-}
-
 // The ideal element through x -> a x + b (mu_test_util.hpp), for 2D in the plane z = 0.
 std::vector<double> ideal_through(const ElementType& t, const Eigen::Matrix3d& a) {
   return test::affine_ideal_element(t, a, Eigen::Vector3d(0.25, -1.5, t.dim == 3 ? 2.0 : 0.0));
@@ -131,7 +111,7 @@ TEST(MuHighOrder, SampledMinimumNeverBelowLowerBound) {
     const int count = t->dim == 3 ? 3 : 6;
     int type_met = 0, type_valid = 0;
     for (int e = 0; e < count; ++e) {
-      const auto x = warped_element(*t, e % 3 == 0 ? 0.03 : (e % 3 == 1 ? 0.1 : 0.2), rng);
+      const auto x = test::smooth_random_element(*t, e % 3 == 0 ? 0.03 : (e % 3 == 1 ? 0.1 : 0.2), rng);
       const QualityBounds b = mu_bounds(*t, x, opt, true);
       ++elements;
       ASSERT_LE(b.lower, b.upper);
@@ -217,7 +197,7 @@ TEST(MuHighOrder, InvertedElementsGetZero) {
     EXPECT_EQ(r.upper, 0.0);
     EXPECT_TRUE(r.tolerance_met);
 
-    auto x = warped_element(*t, 0.05, rng);
+    auto x = test::smooth_random_element(*t, 0.05, rng);
     for (std::size_t i = 1; i < x.size(); i += 3) x[i] = -x[i];
     const LagrangeBasis& basis = lagrange_basis(*t);
     bool all_negative = true;

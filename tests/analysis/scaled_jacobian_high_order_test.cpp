@@ -134,27 +134,6 @@ double sj_at(const ElementType& type, const std::vector<double>& x, const RefPoi
   }
 }
 
-// A curved element as a high-order mesh has it: the nodes of a random affine element
-// (random_element with no displacement) moved by a smooth field
-// d_j(x) = amplitude sin(k_j . x + phase_j) (2D: in the plane). Random node displacements
-// would not do at these orders: the equispaced interpolation amplifies them by its
-// Lebesgue constant times the order, so 0.005 already inverts quadrangles of order 7.
-std::vector<double> smoothly_curved(const ElementType& t, double amplitude, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<double> x = test::random_element(t, 0.0, rng);
-  std::array<Vec, 3> k{};
-  Vec phase{};
-  for (std::size_t j = 0; j < 3; ++j) {
-    for (double& v : k[j]) v = 2 * u(rng);
-    phase[j] = 3 * u(rng);
-  }
-  for (std::size_t i = 0; i + 2 < x.size(); i += 3) {
-    const Vec p = {x[i], x[i + 1], x[i + 2]};
-    for (std::size_t j = 0; j < (t.dim == 2 ? 2u : 3u); ++j) x[i + j] += amplitude * std::sin(dot(k[j], p) + phase[j]);
-  }
-  return x;
-}
-
 QualityBounds bounds(const ElementType& t, const std::vector<double>& x, double tol, int max_subdivisions = 1000) {
   QualityOptions o;
   o.abs_tol = tol;
@@ -216,7 +195,7 @@ TEST(ScaledJacobianHighOrder, DenseSamplingNeverBelowLowerBound) {
     for (int e = 0; e < count; ++e) {
       const bool strong = e % 3 == 2;
       const std::vector<double> x = t.dim == 1 ? test::random_element(t, 0.01, rng)
-                                               : smoothly_curved(t, strong ? 0.3 : 0.08, rng);
+                                               : test::smooth_random_element(t, strong ? 0.3 : 0.08, rng);
       Vec tangent = {x[3] - x[0], x[4] - x[1], x[5] - x[2]};
       const double l = norm(tangent);
       for (double& v : tangent) v /= l;

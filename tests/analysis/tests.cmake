@@ -10,6 +10,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/jacobian_bounds_test.cpp
   analysis/jacobian_exact_test.cpp
   analysis/gmsh_agreement_test.cpp
+  analysis/gmsh_high_order_test.cpp
   analysis/check_cli_test.cpp
   analysis/scaled_jacobian_test.cpp
   analysis/scaled_jacobian_high_order_test.cpp
