@@ -169,14 +169,17 @@ void MuSpace::init_w_space(const std::vector<int>& factor_dims, int n) {
   }
   for (int m : multiples) sizes_[m] = bernstein_space_size(degrees_[m]);
   w_basis_ = std::make_unique<BezierBasis>(type_->family, type_->order, w_factors);
-  std::vector<std::pair<int, int>> pairs{{1, 1}};
-  if (certificate_) {
-    pairs.push_back({2, 2});
-    if (dim_ == 3) pairs.insert(pairs.end(), {{4, 2}, {2, 4}, {4, 4}, {8, 4}, {6, 6}});
-  }
-  for (const auto& [a, b] : pairs)
-    prod_.push_back({{a, b}, &bernstein_product(degrees_[a], degrees_[b])});
+  prod_.push_back({{1, 1}, &bernstein_product(degrees_[1], degrees_[1])});
   ideal_inv_ = ideal_inverse_of(type_->family);
+}
+
+void MuSpace::build_certificate_products() const {
+  std::call_once(certificate_once_, [this] {
+    std::vector<std::pair<int, int>> pairs{{2, 2}};
+    if (dim_ == 3) pairs.insert(pairs.end(), {{4, 2}, {2, 4}, {4, 4}, {8, 4}, {6, 6}});
+    for (const auto& [a, b] : pairs)
+      certificate_prod_.push_back({{a, b}, &bernstein_product(degrees_[a], degrees_[b])});
+  });
 }
 
 PyramidColumnMaps pyramid_column_maps(const ElementType& type) {
@@ -381,7 +384,10 @@ MuSpace::MuSpace(const ElementType& type) : type_(&type) {
 }
 
 const BernsteinProduct& MuSpace::prod(int a, int b) const {
-  for (const auto& [key, table] : prod_)
+  if (a == 1 && b == 1) return *prod_.front().second;
+  QV_ASSERT(certificate_, "no certificate, so no product table (" << a << ", " << b << ")");
+  build_certificate_products();
+  for (const auto& [key, table] : certificate_prod_)
     if (key.first == a && key.second == b) return *table;
   QV_ASSERT(false, "no product table (" << a << ", " << b << ")");
   return *prod_.front().second;

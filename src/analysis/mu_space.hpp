@@ -6,6 +6,7 @@
 // polynomials. Built once per type, immutable, shared by all threads. Internal.
 #include <array>
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "bezier/bernstein_product.hpp"
@@ -79,7 +80,9 @@ class MuSpace {
   const std::array<double, 9>& ideal_inverse() const noexcept { return ideal_inv_; }
 
   /// Product tables (degrees in units of n): (1, 1); with the certificate also (2, 2), and
-  /// in 3D (4, 2), (2, 4), (4, 4), (8, 4), (6, 6). @pre the table exists (QV_ASSERT)
+  /// in 3D (4, 2), (2, 4), (4, 4), (8, 4), (6, 6), built on first use (thread-safe): few
+  /// elements ever need the certificate, and its exact tables are most of a type's set-up
+  /// (0.75 s of the cubic tetrahedron's 0.75 s). @pre the table exists (QV_ASSERT)
   const BernsteinProduct& prod(int a, int b) const;
 
  private:
@@ -99,7 +102,10 @@ class MuSpace {
   std::vector<double> deriv_[3];
   double row_sum_[3] = {};
   std::array<double, 9> ideal_inv_{};
-  std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> prod_;
+  std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> prod_;  // (1, 1)
+  void build_certificate_products() const;
+  mutable std::once_flag certificate_once_;
+  mutable std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> certificate_prod_;
 };
 
 /// Pyramids: the exact maps from the nodes to the Bézier control values of the columns
