@@ -59,9 +59,11 @@ struct Scratch {
 class Bounder {
  public:
   /// valid: J > 0 is proven on the whole element (jacobian_bounds), so every subdomain
-  /// takes the positive branch without its own coefficient test.
-  Bounder(const ScaledJacobianSpace& space, std::size_t size, bool valid)
-      : space_(space), size_(size), frames_(space.frames().size()), valid_(valid) {}
+  /// takes the positive branch without its own coefficient test. signed_volume: |V_k| = |J|
+  /// (3D, planar 2D, 1D), so that sj = s J / sqrt(D_k); not for surface elements in 3D.
+  Bounder(const ScaledJacobianSpace& space, std::size_t size, bool valid, bool signed_volume)
+      : space_(space), size_(size), frames_(space.frames().size()), valid_(valid),
+        signed_volume_(signed_volume) {}
 
   // Certified lower bound of sj on the subdomain (see scaled_jacobian.hpp).
   double lower(const double* v, const double* err) const {
@@ -98,7 +100,27 @@ class Bounder {
       }
     }
     ub = std::min(ub, 1.0);
-    return -up(space_.s_hi() * up(std::sqrt(ub)));
+    const double squared = -up(space_.s_hi() * up(std::sqrt(ub)));
+    return signed_volume_ ? std::max(squared, signed_lower(v, err)) : squared;
+  }
+
+  // Where sj = s J / sqrt(D_k): sj >= 0 where J >= 0, and where J < 0, J >= J_lo (the
+  // least coefficient of J, convex hull) and sqrt(D_k) >= sqrt(D_k,lo) (the least of D_k),
+  // so sj >= s J_lo / sqrt(D_k,lo). Unlike the bound from N = J^2, it does not count the
+  // |sj| of the part where J > 0: on a subdomain across the fold, where the positive part
+  // dominates max N / D_k, it is the sharper one (warped_prism_o2_N6_a0.25: 6274 -> 848
+  // subdivisions, at most 15 instead of 414 per element).
+  double signed_lower(const double* v, const double* err) const {
+    const double j_lo = down(*std::min_element(v, v + size_) - err[0]);
+    if (j_lo >= 0) return 0;
+    double out = 0;
+    for (std::size_t k = 0; k < frames_; ++k) {
+      const double* d = v + (2 + k) * size_;
+      const double d_lo = down(*std::min_element(d, d + size_) - err[2 + k]);
+      if (!(d_lo > 0)) return floor();
+      out = std::min(out, -up(space_.s_hi() * up(-j_lo / down(std::sqrt(d_lo)))));
+    }
+    return out;
   }
 
   // The value lower() takes where neither J > 0 nor a bound on N / D_k is proven.
@@ -152,6 +174,7 @@ class Bounder {
   const ScaledJacobianSpace& space_;
   std::size_t size_, frames_;
   bool valid_;
+  bool signed_volume_;
 };
 
 // A coefficient vector with its bounds: |entries| <= m (computed), |entry - exact| <= e.
@@ -387,7 +410,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   ws.states.assign(1, b2.root_state());
   // valid lets every subdomain skip its own sign test (the J vector is then a
   // placeholder); invalid means a point with J <= 0, where sj <= 0.
-  Bounder bounder(space, s2, v == Validity::valid);
+  Bounder bounder(space, s2, v == Validity::valid, !area);
   double upper = v == Validity::invalid ? 0.0 : space.s_hi();
 
   const double tol = options.abs_tol;
