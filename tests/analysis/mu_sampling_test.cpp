@@ -54,14 +54,7 @@ TEST(MuSampling, SampledMinimumNeverBelowLowerBound) {
         EXPECT_LE(b.upper - b.lower, opt.abs_tol);
       }
       if (b.upper == 0) continue;  // invalid: mu = 0
-      double lo = 1, hi = 0;
-      bool negative = false;
-      for (const auto& p : pts) {
-        if (test::jacobian_at(basis, x, p, true) <= 0) negative = true;
-        const double m = test::pointwise_mu(basis, x, p);
-        lo = std::min(lo, m);
-        hi = std::max(hi, m);
-      }
+      const auto [lo, hi, negative] = test::sample_mu(basis, x, pts);
       if (negative) {
         EXPECT_EQ(b.lower, 0.0) << "a sample with J <= 0 in an element with mu > 0";
         continue;

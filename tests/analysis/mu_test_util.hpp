@@ -4,10 +4,12 @@
 // ideal elements' vertices (no code shared with src/analysis/mu_*), and element makers.
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <vector>
 
+#include "jacobian_test_util.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/lagrange_basis.hpp"
 
@@ -73,6 +75,24 @@ inline double pointwise_mu(const LagrangeBasis& basis, const std::vector<double>
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(w);
   const auto s = svd.singularValues();
   return s(s.size() - 1) / s(0);
+}
+
+/// pointwise_mu sampled at `points`: its least and greatest value, and whether J <= 0 at
+/// one of them (planar J for 2D elements: jacobian_at).
+struct SampledMu {
+  double lo = 1, hi = 0;
+  bool j_nonpositive = false;
+};
+inline SampledMu sample_mu(const LagrangeBasis& basis, const std::vector<double>& x,
+                           const std::vector<RefPoint>& points) {
+  SampledMu out;
+  for (const RefPoint& p : points) {
+    if (jacobian_at(basis, x, p, true) <= 0) out.j_nonpositive = true;
+    const double m = pointwise_mu(basis, x, p);
+    out.lo = std::min(out.lo, m);
+    out.hi = std::max(out.hi, m);
+  }
+  return out;
 }
 
 /// Nodes of `type` placed by an affine map of the ideal element: x = A y + b, y the ideal

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "jacobian_test_util.hpp"
+#include "scaled_jacobian_test_util.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/lagrange_basis.hpp"
 #include "quadval/scaled_jacobian.hpp"
@@ -22,38 +23,15 @@
 namespace quadval {
 namespace {
 
-using Vec = std::array<double, 3>;
-
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
-Vec minus(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-Vec combo(const std::array<Vec, 3>& c, const Vec& w) {
-  Vec out{};
-  for (std::size_t k = 0; k < 3; ++k)
-    for (std::size_t j = 0; j < 3; ++j) out[j] += w[k] * c[k][j];
-  return out;
-}
+using test::combo;
+using test::cross;
+using test::dot;
+using test::minus;
+using test::norm;
+using test::straight_element;
+using test::Vec;
 
 const ElementType& type_of(ElementFamily f, int order) { return *find_element_type(f, order, true); }
-
-// The nodes of `type` on the straight element through `corners` (vertices in Gmsh order),
-// placed with the first-order shape functions.
-std::vector<double> straight_element(const ElementType& type, const std::vector<Vec>& corners) {
-  const LagrangeBasis& lb = lagrange_basis(*find_element_type(type.family, 1, true));
-  std::vector<double> x, w(static_cast<std::size_t>(lb.num_nodes()));
-  for (const RefPoint& p : reference_nodes(type)) {
-    lb.evaluate(p, w);
-    for (std::size_t j = 0; j < 3; ++j) {
-      double v = 0;
-      for (std::size_t i = 0; i < corners.size(); ++i) v += w[i] * corners[i][j];
-      x.push_back(v);
-    }
-  }
-  return x;
-}
 
 // Pointwise sj from the definition in scaled_jacobian.hpp: columns c_j = dX/dxi_j from the
 // shape-function gradients, each corner frame's edge vectors, s |det| sign(J) / product.

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "jacobian_test_util.hpp"
+#include "scaled_jacobian_test_util.hpp"
 #include "quadval/io.hpp"
 #include "quadval/jacobian_bounds.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -20,32 +21,13 @@
 namespace quadval {
 namespace {
 
-using Vec = std::array<double, 3>;
-
-Vec cross(const Vec& a, const Vec& b) {
-  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-}
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-double norm(const Vec& a) { return std::sqrt(dot(a, a)); }
-Vec minus(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
-
-// Nodes of `type` placed by an affine map of the straight element through `corners`
-// (family vertices in Gmsh order), using the first-order shape functions.
-std::vector<double> straight_element(const ElementType& type, const std::vector<Vec>& corners) {
-  const ElementType* linear = find_element_type(type.family, 1, true);
-  const LagrangeBasis& lb = lagrange_basis(*linear);
-  std::vector<double> x;
-  std::vector<double> w(static_cast<std::size_t>(lb.num_nodes()));
-  for (const RefPoint& p : reference_nodes(type)) {
-    lb.evaluate(p, w);
-    for (std::size_t j = 0; j < 3; ++j) {
-      double v = 0;
-      for (std::size_t i = 0; i < corners.size(); ++i) v += w[i] * corners[i][j];
-      x.push_back(v);
-    }
-  }
-  return x;
-}
+using test::combo;
+using test::cross;
+using test::dot;
+using test::minus;
+using test::norm;
+using test::straight_element;
+using test::Vec;
 
 // The pointwise scaled Jacobian by the vertex formulation: the affinely mapped reference
 // element spanned by the columns c_j, its corner edge products, J's sign as in
