@@ -169,7 +169,7 @@ void MuSpace::init_w_space(const std::vector<int>& factor_dims, int n) {
   }
   for (int m : multiples) sizes_[m] = bernstein_space_size(degrees_[m]);
   w_basis_ = std::make_unique<BezierBasis>(type_->family, type_->order, w_factors);
-  prod_.push_back({{1, 1}, &bernstein_product(degrees_[1], degrees_[1])});
+  prod11_ = &bernstein_product(degrees_[1], degrees_[1]);
   ideal_inv_ = ideal_inverse_of(type_->family);
 }
 
@@ -384,13 +384,13 @@ MuSpace::MuSpace(const ElementType& type) : type_(&type) {
 }
 
 const BernsteinProduct& MuSpace::prod(int a, int b) const {
-  if (a == 1 && b == 1) return *prod_.front().second;
+  if (a == 1 && b == 1) return *prod11_;
   QV_ASSERT(certificate_, "no certificate, so no product table (" << a << ", " << b << ")");
   build_certificate_products();
   for (const auto& [key, table] : certificate_prod_)
     if (key.first == a && key.second == b) return *table;
   QV_ASSERT(false, "no product table (" << a << ", " << b << ")");
-  return *prod_.front().second;
+  return *prod11_;
 }
 
 const MuSpace& mu_space(const ElementType& type) {

@@ -102,7 +102,7 @@ class MuSpace {
   std::vector<double> deriv_[3];
   double row_sum_[3] = {};
   std::array<double, 9> ideal_inv_{};
-  std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> prod_;  // (1, 1)
+  const BernsteinProduct* prod11_ = nullptr;  // (1, 1): the control matrices of M
   void build_certificate_products() const;
   mutable std::once_flag certificate_once_;
   mutable std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> certificate_prod_;
