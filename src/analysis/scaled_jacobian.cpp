@@ -6,7 +6,10 @@
 #include "quadval/scaled_jacobian.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <deque>
 #include <limits>
 #include <map>
 #include <vector>
@@ -252,13 +255,218 @@ void linear_sum(const Poly* const* q, const double* w, std::size_t n, Poly& p) {
   p.b.e = e + rounding_gamma(2 * static_cast<int>(n)) * m;
 }
 
+using Columns = std::array<std::array<Poly, 3>, 3>;  // [column c][coordinate]
+
+// Frame column j of frame fr (the components of v_j = sum_c fr[j][c] c_c) into vj.
+void frame_column(const Frame& fr, std::size_t j, std::size_t dim, const Columns& col, std::array<Poly, 3>& vj) {
+  for (std::size_t x = 0; x < 3; ++x) {
+    const Poly* q[3];
+    double wt[3];
+    std::size_t terms = 0;
+    for (std::size_t c = 0; c < dim; ++c)
+      if (fr[j][c] != 0) {
+        q[terms] = &col[c][x];
+        wt[terms++] = fr[j][c];
+      }
+    linear_sum(q, wt, terms, vj[x]);
+  }
+}
+
+// Index of the coefficient at corner m (0..dim) of one simplex factor of degree n: the
+// multi-index with n at m, in simplex_multi_indices order (0, n, then the last of the first
+// layer, then the last); degree 0 has the one coefficient.
+int factor_corner(int dim, int n, int m) {
+  if (m == 0) return 0;
+  if (m == 1) return n;
+  const int triangle = (n + 1) * (n + 2) / 2;
+  if (m == 2) return triangle - 1;
+  return dim == 3 ? triangle * (n + 3) / 3 - 1 : 0;
+}
+
+// The coefficients that are values at the element's corners (every tuple of factor
+// corners), in one fixed corner order for any degrees: entry i of two spaces is the same
+// point. Tensor layout i_0 + s_0 (i_1 + s_1 i_2), factor 0 fastest.
+std::vector<int> corner_indices(const std::vector<FactorDegree>& deg) {
+  std::vector<int> out{0};
+  int stride = 1;
+  for (const FactorDegree& f : deg) {
+    std::vector<int> next;
+    for (int m = 0; m <= f.dim; ++m)
+      for (int i : out) next.push_back(i + stride * factor_corner(f.dim, f.degree, m));
+    out.swap(next);
+    stride *= static_cast<int>(simplex_multi_indices(f.dim, f.degree).size());
+  }
+  return out;
+}
+
+// Per degree vector, its corner indices, looked up once per thread (a few spaces per type:
+// a linear search of packed keys; a deque, so that references stay valid as it grows).
+const std::vector<int>& corners_of(const std::vector<FactorDegree>& deg) {
+  thread_local std::deque<std::pair<std::uint64_t, std::vector<int>>> cache;
+  std::uint64_t key = deg.size();
+  for (const FactorDegree& f : deg) key = key * 4096 + static_cast<std::uint64_t>(f.dim * 1024 + f.degree);
+  for (const auto& [k, corners] : cache)
+    if (k == key) return corners;
+  return cache.emplace_back(key, corner_indices(deg)).second;
+}
+
+// sj from J and the frame columns alone, where J > 0 is proven on the element and
+// |V_k| = J (3D, planar 2D, 1D): sj = s J / prod_j |v_kj|, and by the convex hull
+// property J >= J_lo (least coefficient) and |v_kj| <= max_i |control point i| (the norm is
+// convex), so sj >= s J_lo / prod_j max_i |V_kj,i| for every frame; the corners, where the
+// coefficients are values, bound sj(E) from above. Exact for straight-sided simplices
+// (constant J and columns), and within the tolerance for most mildly curved elements, at
+// the cost of J alone.
+// Errors: a frame column is a sum of at most 3 columns with weights +-1, so each computed
+// coordinate is within e = sum |w| e_c + gamma_6 sum |w| m_c of the exact one (as in
+// linear_sum), which moves a control point's norm by at most sqrt(3) e; the norms' own
+// rounding (a few ulps) is covered by a relative 1e-12.
+QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const Columns& col, const Poly& jac) {
+  QualityBounds out;
+  out.lower = -kInf;
+  out.upper = space.s_hi();
+  const double j_lo = down(*std::min_element(jac.c.begin(), jac.c.end()) - jac.b.e);
+  if (!(j_lo > 0)) return out;
+  const std::vector<int>& j_corners = corners_of(jac.deg);
+  const std::size_t corners = j_corners.size();
+  const auto dim = static_cast<std::size_t>(space.dim());
+  QV_ASSERT(dim <= 3, "dimension " << dim);
+  const double gamma = rounding_gamma(6);
+  double lower = kInf;
+  thread_local std::vector<double> sumsq;  // [column j][coefficient i]: |V_kj,i|^2 as computed
+  std::array<std::size_t, 3> size{}, offset{};
+  std::array<const std::vector<int>*, 3> v_corners{};
+  std::array<double, 3> spread{};
+  for (const Frame& fr : space.frames()) {
+    double norm_product = 1;
+    sumsq.clear();
+    for (std::size_t j = 0; j < dim; ++j) {
+      std::array<const std::array<Poly, 3>*, 3> term{};  // the columns in the sum
+      std::array<double, 3> weight{};
+      std::size_t terms = 0;
+      double e = 0;
+      for (std::size_t c = 0; c < dim; ++c) {
+        if (fr[j][c] == 0) continue;
+        term[terms] = &col[c];
+        weight[terms++] = fr[j][c];
+        for (std::size_t x = 0; x < 3; ++x) e = std::max(e, col[c][x].b.e + gamma * col[c][x].b.m);
+      }
+      spread[j] = up(1.7320508075688772 * (1 + 1e-12) * up(static_cast<double>(terms) * e * (1 + 1e-12)));
+      size[j] = (*term[0])[0].c.size();
+      offset[j] = sumsq.size();
+      v_corners[j] = &corners_of((*term[0])[0].deg);
+      double big = 0;
+      for (std::size_t i = 0; i < size[j]; ++i) {
+        double sum = 0;
+        for (std::size_t x = 0; x < 3; ++x) {
+          double v = 0;
+          for (std::size_t t = 0; t < terms; ++t) v += weight[t] * (*term[t])[x].c[i];
+          sum += v * v;
+        }
+        sumsq.push_back(sum);
+        big = std::max(big, sum);
+      }
+      norm_product = up(norm_product * up(up(std::sqrt(big) * (1 + 1e-12)) + spread[j]));
+    }
+    lower = std::min(lower, down(space.s_lo() * down(j_lo / norm_product)));
+    // The corner of least sj estimated from the squares (any corner gives a true upper
+    // bound; the estimate only picks a sharp one), then certified there.
+    std::size_t best = corners;
+    double best_square = kInf;
+    for (std::size_t m = 0; m < corners; ++m) {
+      double denominator = 1;
+      for (std::size_t j = 0; j < dim; ++j) denominator *= sumsq[offset[j] + static_cast<std::size_t>((*v_corners[j])[m])];
+      const double jm = jac.c[static_cast<std::size_t>(j_corners[m])];
+      if (denominator > 0 && jm * jm / denominator < best_square) {
+        best_square = jm * jm / denominator;
+        best = m;
+      }
+    }
+    if (best == corners) continue;
+    double denominator = 1;
+    for (std::size_t j = 0; j < dim; ++j) {
+      const double square = sumsq[offset[j] + static_cast<std::size_t>((*v_corners[j])[best])];
+      const double norm_lo = down(down(std::sqrt(square) * (1 - 1e-12)) - spread[j]);
+      denominator = norm_lo > 0 ? down(denominator * norm_lo) : 0;
+    }
+    if (!(denominator > 0)) continue;  // a column may vanish there: no value from this corner
+    const double j_hi = up(jac.c[static_cast<std::size_t>(j_corners[best])] + jac.b.e);
+    out.upper = std::min(out.upper, up(space.s_hi() * up(j_hi / denominator)));
+  }
+  out.lower = lower;
+  out.tolerance_met = true;
+  return out;
+}
+
 // The polynomials of one element, reused from element to element.
 struct Polys {
-  std::array<std::array<Poly, 3>, 3> col;
+  Columns col;
   std::array<Poly, 3> w, v;
   Poly jac, n, jsq, one, sq, prod, tmp;
   std::vector<Poly> dk;
 };
+
+// Steps 1 and 2a of scaled_jacobian_bounds_given for one element: its columns and J, into
+// polys (values: scratch for the node differences).
+void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const double> nodes, bool planar,
+                          Polys& polys, std::vector<double>& values) {
+  const ElementType& type = space.type();
+  const auto udim = static_cast<std::size_t>(type.dim);
+  const int dim = type.dim;
+  const auto nn = static_cast<std::size_t>(type.num_nodes);
+  // 1. Bézier coefficients of the columns of J_p in their own degrees: an exact linear
+  //    map of x_i - x_0 (the maps' rows sum to zero: the translation is exact in the
+  //    definition); error (4u entries + u differences + gamma_N sums) * row sum * R,
+  //    counted as 6u + gamma_N.
+  double range = 0;
+  values.resize(nn * 3);
+  for (std::size_t i = 0; i < nn; ++i)
+    for (std::size_t j = 0; j < 3; ++j) {
+      values[i * 3 + j] = nodes[3 * i + j] - nodes[j];
+      range = std::max(range, std::abs(values[i * 3 + j]));
+    }
+  auto& col = polys.col;
+  for (std::size_t c = 0; c < udim; ++c) {
+    const std::vector<double>& m = space.column_map(static_cast<int>(c));
+    const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
+    const double e = (6 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c)) * range * 1.01;
+    for (std::size_t j = 0; j < 3; ++j) {
+      Poly& p = col[c][j];
+      p.deg = space.column_degrees(static_cast<int>(c));
+      p.c.assign(rows, 0.0);
+      for (std::size_t r = 0; r < rows; ++r) {
+        double sum = 0;
+        for (std::size_t i = 0; i < nn; ++i) sum += m[r * nn + i] * values[i * 3 + j];
+        p.c[r] = sum;
+      }
+      refresh_magnitude(p);
+      p.b.e = e;
+    }
+  }
+
+  // 2a. J by Bernstein products (w = the cross product of the first two columns in 2D, of
+  //     the last two in 3D).
+  const auto ref = reference_direction(type, nodes.data(), planar);
+  Poly& jac = polys.jac;
+  auto& w = polys.w;
+  if (dim == 3) {
+    for (std::size_t x = 0; x < 3; ++x) {  // w = c_1 x c_2
+      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
+      product_sum({{&col[1][y], &col[2][z], 1.0}, {&col[1][z], &col[2][y], -1.0}}, w[x]);
+    }
+    product_sum({{&col[0][0], &w[0], 1.0}, {&col[0][1], &w[1], 1.0}, {&col[0][2], &w[2], 1.0}}, jac);
+  } else if (dim == 2) {
+    for (std::size_t x = 0; x < 3; ++x) {  // w = c_0 x c_1
+      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
+      product_sum({{&col[0][y], &col[1][z], 1.0}, {&col[0][z], &col[1][y], -1.0}}, w[x]);
+    }
+    const Poly* q[3] = {&w[0], &w[1], &w[2]};
+    linear_sum(q, ref.data(), 3, jac);
+  } else {
+    const Poly* q[3] = {&col[0][0], &col[0][1], &col[0][2]};
+    linear_sum(q, ref.data(), 3, jac);
+  }
+}
 
 }  // namespace
 
@@ -275,6 +483,17 @@ QualityBounds scaled_jacobian_bounds(const ElementType& type, std::span<const do
   return scaled_jacobian_bounds_given(type, nodes, options, planar, v);
 }
 
+QualityBounds scaled_jacobian_first_stage(const ElementType& type, std::span<const double> nodes, bool planar) {
+  QV_ASSERT(scaled_jacobian_supported(type) && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
+            "first stage of " << type.name);
+  const ScaledJacobianSpace& space = scaled_jacobian_space(type);
+  if (type.dim == 2 && !planar) return {-kInf, space.s_hi(), 0, false};
+  thread_local Polys polys;
+  thread_local std::vector<double> values;
+  columns_and_jacobian(space, nodes, planar, polys, values);
+  return quotient_bounds(space, polys.col, polys.jac);
+}
+
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
                                            const QualityOptions& options, bool planar, Validity v) {
   QV_ASSERT(scaled_jacobian_supported(type), "no scaled Jacobian for " << type.name);
@@ -286,70 +505,26 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   const auto s2 = static_cast<std::size_t>(b2.size());
   const int dim = type.dim;
   const auto udim = static_cast<std::size_t>(dim);
-  const auto nn = static_cast<std::size_t>(type.num_nodes);
   const std::size_t frames = space.frames().size();
   const std::size_t nvec = 2 + frames;
 
-  // 1. Bézier coefficients of the columns of J_p in their own degrees: an exact linear
-  //    map of x_i - x_0 (the maps' rows sum to zero: the translation is exact in the
-  //    definition); error (4u entries + u differences + gamma_N sums) * row sum * R,
-  //    counted as 6u + gamma_N.
-  double range = 0;
-  ws.values.resize(nn * 3);
-  for (std::size_t i = 0; i < nn; ++i)
-    for (std::size_t j = 0; j < 3; ++j) {
-      ws.values[i * 3 + j] = nodes[3 * i + j] - nodes[j];
-      range = std::max(range, std::abs(ws.values[i * 3 + j]));
-    }
   thread_local Polys polys;
   auto& col = polys.col;
-  for (std::size_t c = 0; c < udim; ++c) {
-    const std::vector<double>& m = space.column_map(static_cast<int>(c));
-    const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
-    const double e = (6 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c)) * range * 1.01;
-    for (std::size_t j = 0; j < 3; ++j) {
-      Poly& p = col[c][j];
-      p.deg = space.column_degrees(static_cast<int>(c));
-      p.c.assign(rows, 0.0);
-      for (std::size_t r = 0; r < rows; ++r) {
-        double sum = 0;
-        for (std::size_t i = 0; i < nn; ++i) sum += m[r * nn + i] * ws.values[i * 3 + j];
-        p.c[r] = sum;
-      }
-      refresh_magnitude(p);
-      p.b.e = e;
-    }
-  }
-
-  // 2. J, N = |V|^2 and D_k = prod_j |v_kj|^2 by Bernstein products.
-  const auto ref = reference_direction(type, nodes.data(), planar);
   const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2
+  columns_and_jacobian(space, nodes, planar, polys, ws.values);
   Poly& jac = polys.jac;
   Poly& n = polys.n;
   auto& w = polys.w;
-  if (dim == 3) {
-    for (std::size_t x = 0; x < 3; ++x) {  // w = c_1 x c_2
-      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
-      product_sum({{&col[1][y], &col[2][z], 1.0}, {&col[1][z], &col[2][y], -1.0}}, w[x]);
-    }
-    product_sum({{&col[0][0], &w[0], 1.0}, {&col[0][1], &w[1], 1.0}, {&col[0][2], &w[2], 1.0}}, jac);
-    product_sum({{&jac, &jac, 1.0}}, n);
-  } else if (dim == 2) {
-    for (std::size_t x = 0; x < 3; ++x) {  // w = c_0 x c_1
-      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
-      product_sum({{&col[0][y], &col[1][z], 1.0}, {&col[0][z], &col[1][y], -1.0}}, w[x]);
-    }
-    const Poly* q[3] = {&w[0], &w[1], &w[2]};
-    linear_sum(q, ref.data(), 3, jac);
-    if (area)
-      product_sum({{&w[0], &w[0], 1.0}, {&w[1], &w[1], 1.0}, {&w[2], &w[2], 1.0}}, n);
-    else
-      product_sum({{&jac, &jac, 1.0}}, n);
-  } else {
-    const Poly* q[3] = {&col[0][0], &col[0][1], &col[0][2]};
-    linear_sum(q, ref.data(), 3, jac);
-    product_sum({{&jac, &jac, 1.0}}, n);
+  // The first stage (quotient_bounds): on a valid element, J and the frame columns alone
+  // often settle sj, without the products of twice the degree below.
+  if (v == Validity::valid && !area) {
+    const QualityBounds quick = quotient_bounds(space, col, jac);
+    if (up(quick.upper - quick.lower) <= options.abs_tol) return quick;
   }
+  if (area)
+    product_sum({{&w[0], &w[0], 1.0}, {&w[1], &w[1], 1.0}, {&w[2], &w[2], 1.0}}, n);
+  else
+    product_sum({{&jac, &jac, 1.0}}, n);
   // J in the squared space (J * 1, 1 with all coefficients 1 in J's space), for the sign
   // tests of the subdomains; not needed when J > 0 is proven on the whole element.
   Poly& jsq = polys.jsq;
@@ -371,17 +546,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     Poly& prod = polys.prod;
     for (std::size_t j = 0; j < udim; ++j) {
       auto& vj = polys.v;
-      for (std::size_t x = 0; x < 3; ++x) {
-        const Poly* q[3];
-        double wt[3];
-        std::size_t terms = 0;
-        for (std::size_t c = 0; c < udim; ++c)
-          if (fr[j][c] != 0) {
-            q[terms] = &col[c][x];
-            wt[terms++] = fr[j][c];
-          }
-        linear_sum(q, wt, terms, vj[x]);
-      }
+      frame_column(fr, j, udim, col, vj);
       Poly& sq = j == 0 ? prod : polys.sq;
       product_sum({{&vj[0], &vj[0], 1.0}, {&vj[1], &vj[1], 1.0}, {&vj[2], &vj[2], 1.0}}, sq);
       if (j > 0) {

@@ -78,6 +78,13 @@ class ScaledJacobianSpace {
 /// The shared space of `type`; thread-safe, built once. @pre scaled_jacobian_supported(type)
 const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type);
 
+/// The first stage of scaled_jacobian_bounds_given on its own (tests): bounds of sj(E) from J
+/// and the frame columns alone, s J_lo / prod_j max |v_kj| below and the least corner value
+/// above (scaled_jacobian.cpp, quotient_bounds). Certified when J > 0 on the whole element;
+/// lower = -inf when J's least coefficient is not positive or for a surface element in 3D.
+/// tolerance_met is true whenever lower is finite (the caller compares the gap).
+QualityBounds scaled_jacobian_first_stage(const ElementType& type, std::span<const double> nodes, bool planar);
+
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian
 /// engine (jacobian_bounds, any goal: only the sign of min J is used), as check_mesh has
 /// it; results are identical. @pre v is that element's certified validity.
