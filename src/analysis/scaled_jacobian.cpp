@@ -8,14 +8,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdint>
-#include <deque>
 #include <limits>
 #include <map>
 #include <vector>
 
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/scaled_jacobian_quotient.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
@@ -29,6 +28,9 @@ constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
+// Splits of J and the columns before the products (the quotient stage): measured on the
+// shared curved meshes (bench/compare_gmsh_check.py --quality), more rarely settle more.
+constexpr int kQuotientSplits = 4;
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
 // rounding of at most u per operation; the final bounds are enlarged by 1% to cover the
@@ -272,132 +274,6 @@ void frame_column(const Frame& fr, std::size_t j, std::size_t dim, const Columns
   }
 }
 
-// Index of the coefficient at corner m (0..dim) of one simplex factor of degree n: the
-// multi-index with n at m, in simplex_multi_indices order (0, n, then the last of the first
-// layer, then the last); degree 0 has the one coefficient.
-int factor_corner(int dim, int n, int m) {
-  if (m == 0) return 0;
-  if (m == 1) return n;
-  const int triangle = (n + 1) * (n + 2) / 2;
-  if (m == 2) return triangle - 1;
-  return dim == 3 ? triangle * (n + 3) / 3 - 1 : 0;
-}
-
-// The coefficients that are values at the element's corners (every tuple of factor
-// corners), in one fixed corner order for any degrees: entry i of two spaces is the same
-// point. Tensor layout i_0 + s_0 (i_1 + s_1 i_2), factor 0 fastest.
-std::vector<int> corner_indices(const std::vector<FactorDegree>& deg) {
-  std::vector<int> out{0};
-  int stride = 1;
-  for (const FactorDegree& f : deg) {
-    std::vector<int> next;
-    for (int m = 0; m <= f.dim; ++m)
-      for (int i : out) next.push_back(i + stride * factor_corner(f.dim, f.degree, m));
-    out.swap(next);
-    stride *= static_cast<int>(simplex_multi_indices(f.dim, f.degree).size());
-  }
-  return out;
-}
-
-// Per degree vector, its corner indices, looked up once per thread (a few spaces per type:
-// a linear search of packed keys; a deque, so that references stay valid as it grows).
-const std::vector<int>& corners_of(const std::vector<FactorDegree>& deg) {
-  thread_local std::deque<std::pair<std::uint64_t, std::vector<int>>> cache;
-  std::uint64_t key = deg.size();
-  for (const FactorDegree& f : deg) key = key * 4096 + static_cast<std::uint64_t>(f.dim * 1024 + f.degree);
-  for (const auto& [k, corners] : cache)
-    if (k == key) return corners;
-  return cache.emplace_back(key, corner_indices(deg)).second;
-}
-
-// sj from J and the frame columns alone, where J > 0 is proven on the element and
-// |V_k| = J (3D, planar 2D, 1D): sj = s J / prod_j |v_kj|, and by the convex hull
-// property J >= J_lo (least coefficient) and |v_kj| <= max_i |control point i| (the norm is
-// convex), so sj >= s J_lo / prod_j max_i |V_kj,i| for every frame; the corners, where the
-// coefficients are values, bound sj(E) from above. Exact for straight-sided simplices
-// (constant J and columns), and within the tolerance for most mildly curved elements, at
-// the cost of J alone.
-// Errors: a frame column is a sum of at most 3 columns with weights +-1, so each computed
-// coordinate is within e = sum |w| e_c + gamma_6 sum |w| m_c of the exact one (as in
-// linear_sum), which moves a control point's norm by at most sqrt(3) e; the norms' own
-// rounding (a few ulps) is covered by a relative 1e-12.
-QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const Columns& col, const Poly& jac) {
-  QualityBounds out;
-  out.lower = -kInf;
-  out.upper = space.s_hi();
-  const double j_lo = down(*std::min_element(jac.c.begin(), jac.c.end()) - jac.b.e);
-  if (!(j_lo > 0)) return out;
-  const std::vector<int>& j_corners = corners_of(jac.deg);
-  const std::size_t corners = j_corners.size();
-  const auto dim = static_cast<std::size_t>(space.dim());
-  QV_ASSERT(dim <= 3, "dimension " << dim);
-  const double gamma = rounding_gamma(6);
-  double lower = kInf;
-  thread_local std::vector<double> sumsq;  // [column j][coefficient i]: |V_kj,i|^2 as computed
-  std::array<std::size_t, 3> size{}, offset{};
-  std::array<const std::vector<int>*, 3> v_corners{};
-  std::array<double, 3> spread{};
-  for (const Frame& fr : space.frames()) {
-    double norm_product = 1;
-    sumsq.clear();
-    for (std::size_t j = 0; j < dim; ++j) {
-      std::array<const std::array<Poly, 3>*, 3> term{};  // the columns in the sum
-      std::array<double, 3> weight{};
-      std::size_t terms = 0;
-      double e = 0;
-      for (std::size_t c = 0; c < dim; ++c) {
-        if (fr[j][c] == 0) continue;
-        term[terms] = &col[c];
-        weight[terms++] = fr[j][c];
-        for (std::size_t x = 0; x < 3; ++x) e = std::max(e, col[c][x].b.e + gamma * col[c][x].b.m);
-      }
-      spread[j] = up(1.7320508075688772 * (1 + 1e-12) * up(static_cast<double>(terms) * e * (1 + 1e-12)));
-      size[j] = (*term[0])[0].c.size();
-      offset[j] = sumsq.size();
-      v_corners[j] = &corners_of((*term[0])[0].deg);
-      double big = 0;
-      for (std::size_t i = 0; i < size[j]; ++i) {
-        double sum = 0;
-        for (std::size_t x = 0; x < 3; ++x) {
-          double v = 0;
-          for (std::size_t t = 0; t < terms; ++t) v += weight[t] * (*term[t])[x].c[i];
-          sum += v * v;
-        }
-        sumsq.push_back(sum);
-        big = std::max(big, sum);
-      }
-      norm_product = up(norm_product * up(up(std::sqrt(big) * (1 + 1e-12)) + spread[j]));
-    }
-    lower = std::min(lower, down(space.s_lo() * down(j_lo / norm_product)));
-    // The corner of least sj estimated from the squares (any corner gives a true upper
-    // bound; the estimate only picks a sharp one), then certified there.
-    std::size_t best = corners;
-    double best_square = kInf;
-    for (std::size_t m = 0; m < corners; ++m) {
-      double denominator = 1;
-      for (std::size_t j = 0; j < dim; ++j) denominator *= sumsq[offset[j] + static_cast<std::size_t>((*v_corners[j])[m])];
-      const double jm = jac.c[static_cast<std::size_t>(j_corners[m])];
-      if (denominator > 0 && jm * jm / denominator < best_square) {
-        best_square = jm * jm / denominator;
-        best = m;
-      }
-    }
-    if (best == corners) continue;
-    double denominator = 1;
-    for (std::size_t j = 0; j < dim; ++j) {
-      const double square = sumsq[offset[j] + static_cast<std::size_t>((*v_corners[j])[best])];
-      const double norm_lo = down(down(std::sqrt(square) * (1 - 1e-12)) - spread[j]);
-      denominator = norm_lo > 0 ? down(denominator * norm_lo) : 0;
-    }
-    if (!(denominator > 0)) continue;  // a column may vanish there: no value from this corner
-    const double j_hi = up(jac.c[static_cast<std::size_t>(j_corners[best])] + jac.b.e);
-    out.upper = std::min(out.upper, up(space.s_hi() * up(j_hi / denominator)));
-  }
-  out.lower = lower;
-  out.tolerance_met = true;
-  return out;
-}
-
 // The polynomials of one element, reused from element to element.
 struct Polys {
   Columns col;
@@ -405,6 +281,23 @@ struct Polys {
   Poly jac, n, jsq, one, sq, prod, tmp;
   std::vector<Poly> dk;
 };
+
+// The quotient stage's view of an element's J and columns (scaled_jacobian_quotient.hpp).
+QuotientInput quotient_input(const Polys& polys, std::size_t dim) {
+  QuotientInput in;
+  in.j = polys.jac.c;
+  in.j_degrees = &polys.jac.deg;
+  in.j_error = polys.jac.b.e;
+  for (std::size_t c = 0; c < dim; ++c) {
+    in.col_degrees[c] = &polys.col[c][0].deg;
+    for (std::size_t x = 0; x < 3; ++x) {
+      in.col[c][x] = polys.col[c][x].c;
+      in.col_error[c] = std::max(in.col_error[c], polys.col[c][x].b.e);
+      in.col_magnitude[c] = std::max(in.col_magnitude[c], polys.col[c][x].b.m);
+    }
+  }
+  return in;
+}
 
 // Steps 1 and 2a of scaled_jacobian_bounds_given for one element: its columns and J, into
 // polys (values: scratch for the node differences).
@@ -483,15 +376,16 @@ QualityBounds scaled_jacobian_bounds(const ElementType& type, std::span<const do
   return scaled_jacobian_bounds_given(type, nodes, options, planar, v);
 }
 
-QualityBounds scaled_jacobian_first_stage(const ElementType& type, std::span<const double> nodes, bool planar) {
+QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<const double> nodes, bool planar,
+                                             double tol, int max_splits) {
   QV_ASSERT(scaled_jacobian_supported(type) && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
-            "first stage of " << type.name);
+            "quotient stage of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
   if (type.dim == 2 && !planar) return {-kInf, space.s_hi(), 0, false};
   thread_local Polys polys;
   thread_local std::vector<double> values;
   columns_and_jacobian(space, nodes, planar, polys, values);
-  return quotient_bounds(space, polys.col, polys.jac);
+  return quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits);
 }
 
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
@@ -515,11 +409,14 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   Poly& jac = polys.jac;
   Poly& n = polys.n;
   auto& w = polys.w;
-  // The first stage (quotient_bounds): on a valid element, J and the frame columns alone
-  // often settle sj, without the products of twice the degree below.
+  // The first stage (scaled_jacobian_quotient.hpp): on a valid element, J and the frame
+  // columns alone, split a few times, settle most elements without the products of twice
+  // the degree below; its bounds still count when it does not.
+  QualityBounds quick{-kInf, space.s_hi(), 0, false};
   if (v == Validity::valid && !area) {
-    const QualityBounds quick = quotient_bounds(space, col, jac);
-    if (up(quick.upper - quick.lower) <= options.abs_tol) return quick;
+    quick = quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
+                            std::min(kQuotientSplits, options.max_subdivisions));
+    if (quick.tolerance_met) return quick;
   }
   if (area)
     product_sum({{&w[0], &w[0], 1.0}, {&w[1], &w[1], 1.0}, {&w[2], &w[2], 1.0}}, n);
@@ -658,8 +555,9 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   }
   double lower = settled;
   for (const Leaf& l : ws.heap) lower = std::min(lower, l.lower);
-  out.lower = lower;
-  out.upper = upper;
+  out.lower = std::max(lower, quick.lower);
+  out.upper = std::min(upper, quick.upper);
+  out.subdivisions += quick.subdivisions;
   out.tolerance_met = up(out.upper - out.lower) <= tol;
   return out;
 }

@@ -79,11 +79,11 @@ class ScaledJacobianSpace {
 const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type);
 
 /// The first stage of scaled_jacobian_bounds_given on its own (tests): bounds of sj(E) from J
-/// and the frame columns alone, s J_lo / prod_j max |v_kj| below and the least corner value
-/// above (scaled_jacobian.cpp, quotient_bounds). Certified when J > 0 on the whole element;
-/// lower = -inf when J's least coefficient is not positive or for a surface element in 3D.
-/// tolerance_met is true whenever lower is finite (the caller compares the gap).
-QualityBounds scaled_jacobian_first_stage(const ElementType& type, std::span<const double> nodes, bool planar);
+/// and the frame columns alone, refined by at most max_splits splits until upper - lower <=
+/// tol (scaled_jacobian_quotient.hpp). Certified when J > 0 on the whole element; lower =
+/// -inf when J's least coefficient is not positive or for a surface element in 3D.
+QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<const double> nodes, bool planar,
+                                             double tol, int max_splits);
 
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian
 /// engine (jacobian_bounds, any goal: only the sign of min J is used), as check_mesh has

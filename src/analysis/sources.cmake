@@ -8,6 +8,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/ratio_refinement.cpp
   src/analysis/linear_jacobian.cpp
   src/analysis/scaled_jacobian_space.cpp
+  src/analysis/scaled_jacobian_quotient.cpp
   src/analysis/scaled_jacobian.cpp
   src/analysis/mu_space.cpp
   src/analysis/mu_metric.cpp

@@ -305,7 +305,7 @@ TEST(ScaledJacobian, FirstStageIsExactOnStraightElements) {
         return Vec{d[0] / norm(d), d[1] / norm(d), d[2] / norm(d)};
       }();
       const double want = sj_at(t, x, reference_nodes(t)[0], {0, 0, 1}, tangent);
-      const QualityBounds b = scaled_jacobian_first_stage(t, x, /*planar=*/true);
+      const QualityBounds b = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1.0, 0);
       EXPECT_LE(b.lower, want + 1e-12);
       EXPECT_GE(b.upper, want - 1e-12);
       EXPECT_LE(b.upper - b.lower, 1e-7);  // the rounding bounds of order-4 products
@@ -332,7 +332,7 @@ TEST(ScaledJacobian, FirstStageBoundsEncloseSampledAndFullBounds) {
     for (int e = 0; e < (t.dim == 3 ? 12 : 24); ++e) {
       const double amplitude = e % 2 == 0 ? 1e-3 : 2e-2;
       const std::vector<double> x = test::smooth_random_element(t, amplitude, rng);
-      const QualityBounds first = scaled_jacobian_first_stage(t, x, /*planar=*/true);
+      const QualityBounds first = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1.0, 0);
       if (!std::isfinite(first.lower)) continue;  // J's least coefficient not positive
       const QualityBounds full = bounds(t, x, 1e-6);
       EXPECT_LE(first.lower, first.upper);
@@ -356,6 +356,52 @@ TEST(ScaledJacobian, FirstStageBoundsEncloseSampledAndFullBounds) {
   }
   EXPECT_GT(elements, 500u);
   EXPECT_GT(settled, barely * 9 / 10);
+}
+
+// The first stage refined (J and the columns split best-first) on curved valid elements of
+// every family up to order 3: still enclosing the sampled minimum and the full bounds, the
+// gap within the tolerance whenever it says so, and closing it on most of the elements it
+// refines (those whose first gap is within twice the tolerance) in 16 splits.
+TEST(ScaledJacobian, FirstStageRefinedEnclosesAndConverges) {
+  std::mt19937 rng(77);
+  std::size_t elements = 0, refined = 0, met = 0;
+  for (const ElementType& t : element_types()) {
+    if (!scaled_jacobian_supported(t) || t.order > 3) continue;
+    SCOPED_TRACE(std::string(t.name));
+    const auto pts = test::dense_points(t.family, t.dim == 3 ? 6 : 12, 40, rng);
+    for (int e = 0; e < (t.dim == 3 ? 12 : 24); ++e) {
+      const std::vector<double> x = test::smooth_random_element(t, 0.002 + 0.004 * (e % 3), rng);
+      const QualityBounds root = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1e-2, 0);
+      const QualityBounds q = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1e-2, 16);
+      if (!std::isfinite(q.lower)) continue;
+      const QualityBounds full = bounds(t, x, 1e-6);
+      EXPECT_LE(q.lower, q.upper);
+      EXPECT_LE(full.lower, q.upper) << "element " << e;
+      EXPECT_LE(q.lower, full.upper) << "element " << e;
+      EXPECT_LE(q.subdivisions, 16);
+      EXPECT_GE(q.lower, root.lower) << "element " << e;  // refining never loosens
+      if (t.family != ElementFamily::pyramid) {
+        const Vec tangent = [&] {
+          const Vec d = {x[3] - x[0], x[4] - x[1], x[5] - x[2]};
+          return Vec{d[0] / norm(d), d[1] / norm(d), d[2] / norm(d)};
+        }();
+        double sampled = INFINITY;
+        for (const RefPoint& p : pts) sampled = std::min(sampled, sj_at(t, x, p, {0, 0, 1}, tangent));
+        EXPECT_LE(q.lower, sampled + 1e-12) << "element " << e;
+      }
+      if (q.tolerance_met) {
+        EXPECT_LE(q.upper - q.lower, 1e-2);
+      }
+      ++elements;
+      if (q.subdivisions > 0) {
+        ++refined;
+        if (q.tolerance_met) ++met;
+      }
+    }
+  }
+  EXPECT_GT(elements, 500u);
+  EXPECT_GT(refined, 30u);
+  EXPECT_GT(met, refined * 9 / 10);
 }
 
 TEST(ScaledJacobian, SupportedTypes) {

@@ -1,0 +1,335 @@
+// The quotient stage of the scaled-Jacobian bounds (see scaled_jacobian_quotient.hpp).
+#include "analysis/scaled_jacobian_quotient.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <memory>
+
+#include "analysis/jacobian_samples.hpp"
+#include "analysis/outward_rounding.hpp"
+#include "bezier/bernstein_bisection.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kSqrt3 = 1.7320508075688772;  // a hair below sqrt(3): the 1 + 1e-12 of its use covers it
+double down(double x) { return next_down(x); }
+double up(double x) { return next_up(x); }
+constexpr double kReachable = 2;
+
+std::uint64_t key_of(const std::vector<FactorDegree>& deg) {
+  std::uint64_t key = deg.size();
+  for (const FactorDegree& f : deg) key = key * 4096 + static_cast<std::uint64_t>(f.dim * 1024 + f.degree);
+  return key;
+}
+
+// Index of the coefficient at corner m (0..dim) of one simplex factor of degree n: the
+// multi-index with n at m, in simplex_multi_indices order (0, n, then the last of the first
+// layer, then the last); degree 0 has the one coefficient.
+int factor_corner(int dim, int n, int m) {
+  if (m == 0) return 0;
+  if (m == 1) return n;
+  const int triangle = (n + 1) * (n + 2) / 2;
+  if (m == 2) return triangle - 1;
+  return dim == 3 ? triangle * (n + 3) / 3 - 1 : 0;
+}
+
+// The coefficients that are values at the domain's corners (every tuple of factor corners),
+// in one fixed corner order for any degrees, so that entry i of two spaces is the same
+// point. Tensor layout i_0 + s_0 (i_1 + s_1 i_2), factor 0 fastest. A subdomain keeps its
+// corners at these slots (bernstein_bisection.hpp), so they hold at every depth.
+std::vector<int> corner_indices(const std::vector<FactorDegree>& deg) {
+  std::vector<int> out{0};
+  int stride = 1;
+  for (const FactorDegree& f : deg) {
+    std::vector<int> next;
+    for (int m = 0; m <= f.dim; ++m)
+      for (int i : out) next.push_back(i + stride * factor_corner(f.dim, f.degree, m));
+    out.swap(next);
+    stride *= static_cast<int>(simplex_multi_indices(f.dim, f.degree).size());
+  }
+  return out;
+}
+
+// Per degree vector, its corner indices and its bisection, built once per thread (a few
+// spaces per type: a linear search; a deque keeps references valid as it grows).
+struct SpaceTools {
+  std::uint64_t key;
+  std::vector<int> corners;
+  std::unique_ptr<BernsteinBisection> bisection;
+};
+const SpaceTools& tools_of(const std::vector<FactorDegree>& deg) {
+  thread_local std::deque<SpaceTools> cache;
+  const std::uint64_t key = key_of(deg);
+  for (const SpaceTools& t : cache)
+    if (t.key == key) return t;
+  return cache.emplace_back(SpaceTools{key, corner_indices(deg), std::make_unique<BernsteinBisection>(deg)});
+}
+
+// One frame column: the columns it sums, with weights +-1.
+struct FrameColumn {
+  std::array<int, 3> column{};
+  std::array<double, 3> weight{};
+  int terms = 0;
+};
+
+struct Leaf {
+  double lower;
+  int slot;
+  long id;  // creation order: a deterministic tie-break
+};
+
+// The leaves' data: per leaf J then the columns' coordinates, contiguous; per leaf the
+// error bounds of J and of each column, and its bisection state.
+class Quotient {
+ public:
+  Quotient(const ScaledJacobianSpace& space, const QuotientInput& in) : space_(space), in_(in) {
+    dim_ = static_cast<std::size_t>(space.dim());
+    QV_ASSERT(dim_ >= 1 && dim_ <= 3, "dimension " << dim_);
+    j_tools_ = &tools_of(*in.j_degrees);
+    offset_[0] = 0;
+    std::size_t at = in.j.size();
+    for (std::size_t c = 0; c < dim_; ++c) {
+      col_tools_[c] = &tools_of(*in.col_degrees[c]);
+      offset_[c + 1] = at;
+      size_[c] = in.col[c][0].size();
+      at += 3 * size_[c];
+      QV_ASSERT(col_tools_[c]->corners.size() == j_tools_->corners.size(), "corner counts differ");
+    }
+    stride_ = at;
+    for (const Frame& fr : space.frames()) {
+      std::array<FrameColumn, 3> f{};
+      for (std::size_t j = 0; j < dim_; ++j) {
+        for (std::size_t c = 0; c < dim_; ++c)
+          if (fr[j][c] != 0) {
+            f[j].column[static_cast<std::size_t>(f[j].terms)] = static_cast<int>(c);
+            f[j].weight[static_cast<std::size_t>(f[j].terms++)] = fr[j][c];
+          }
+        QV_ASSERT(f[j].terms > 0, "empty frame column");
+        for (int t = 0; t < f[j].terms; ++t)
+          QV_ASSERT(size_[static_cast<std::size_t>(f[j].column[static_cast<std::size_t>(t)])] ==
+                        size_[static_cast<std::size_t>(f[j].column[0])],
+                    "a frame sums columns of different spaces");
+      }
+      frames_.push_back(f);
+    }
+  }
+
+  std::size_t stride() const { return stride_; }
+  std::size_t dim() const { return dim_; }
+
+  // The root leaf, into `leaf` (stride() doubles) and its errors.
+  void root(double* leaf, std::array<double, 4>& err) const {
+    std::copy(in_.j.begin(), in_.j.end(), leaf);
+    err[0] = in_.j_error;
+    for (std::size_t c = 0; c < dim_; ++c) {
+      for (std::size_t x = 0; x < 3; ++x)
+        std::copy(in_.col[c][x].begin(), in_.col[c][x].end(), leaf + offset_[c + 1] + x * size_[c]);
+      err[c + 1] = in_.col_error[c];
+    }
+  }
+
+  // A certified lower bound of sj on the leaf; `upper` is lowered to sj at one of its
+  // corners (the one the squares estimate smallest, per frame), certified there.
+  double bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
+    const std::size_t sj = in_.j.size();
+    const double j_lo = down(*std::min_element(leaf, leaf + sj) - err[0]);
+    const std::vector<int>& j_corners = j_tools_->corners;
+    const std::size_t corners = j_corners.size();
+    double lower = kInf;
+    for (const auto& fr : frames_) {
+      double norm_product = 1;
+      sumsq_.clear();
+      std::array<std::size_t, 3> first{}, col0{};
+      std::array<double, 3> spread{};
+      for (std::size_t j = 0; j < dim_; ++j) {
+        const FrameColumn& f = fr[j];
+        double e = 0;
+        for (int t = 0; t < f.terms; ++t) {
+          const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+          e += err[c + 1] + gamma_ * in_.col_magnitude[c];
+        }
+        spread[j] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
+        col0[j] = static_cast<std::size_t>(f.column[0]);
+        const std::size_t n = size_[col0[j]];
+        first[j] = sumsq_.size();
+        double big = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+          double sum = 0;
+          for (std::size_t x = 0; x < 3; ++x) {
+            double v = 0;
+            for (int t = 0; t < f.terms; ++t) {
+              const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+              v += f.weight[static_cast<std::size_t>(t)] * leaf[offset_[c + 1] + x * n + i];
+            }
+            sum += v * v;
+          }
+          sumsq_.push_back(sum);
+          big = std::max(big, sum);
+        }
+        norm_product = up(norm_product * up(up(std::sqrt(big) * (1 + 1e-12)) + spread[j]));
+      }
+      // J > 0 on the element: sj > 0 everywhere, the bound where J_lo is not positive.
+      lower = std::min(lower, j_lo > 0 ? down(space_.s_lo() * down(j_lo / norm_product)) : 0.0);
+      // The corner of least sj estimated from the squares (any corner gives a true upper
+      // bound; the estimate only picks a sharp one), then certified there.
+      std::size_t best = corners;
+      double best_square = kInf;
+      for (std::size_t m = 0; m < corners; ++m) {
+        double denominator = 1;
+        for (std::size_t j = 0; j < dim_; ++j)
+          denominator *= sumsq_[first[j] + static_cast<std::size_t>(col_tools_[col0[j]]->corners[m])];
+        const double jm = leaf[j_corners[m]];
+        if (denominator > 0 && jm > 0 && jm * jm / denominator < best_square) {
+          best_square = jm * jm / denominator;
+          best = m;
+        }
+      }
+      if (best == corners) continue;
+      double denominator = 1;
+      for (std::size_t j = 0; j < dim_; ++j) {
+        const double square = sumsq_[first[j] + static_cast<std::size_t>(col_tools_[col0[j]]->corners[best])];
+        const double norm_lo = down(down(std::sqrt(square) * (1 - 1e-12)) - spread[j]);
+        denominator = norm_lo > 0 ? down(denominator * norm_lo) : 0;
+      }
+      if (!(denominator > 0)) continue;  // a column may vanish there: no value from this corner
+      const double j_hi = up(leaf[j_corners[best]] + err[0]);
+      upper = std::min(upper, up(space_.s_hi() * up(j_hi / denominator)));
+    }
+    return lower;
+  }
+
+  // Splits the leaf into the 2^dim children (child-major, stride() each) with their states
+  // and errors (the same for all children).
+  void split(const double* leaf, const std::array<double, 4>& err, const BisectionState& state,
+             std::vector<double>& children, std::vector<BisectionState>& states,
+             std::array<double, 4>& child_err) const {
+    const BernsteinBisection& jb = *j_tools_->bisection;
+    const auto nc = static_cast<std::size_t>(jb.num_children());
+    children.resize(nc * stride_);
+    states.resize(nc);
+    const auto child_error = [](const BernsteinBisection& b, double e, const double* v, std::size_t n) {
+      double m = 0;
+      for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::abs(v[i]));
+      return up((e + b.rounding_relative() * m + b.rounding_absolute()) * (1 + 1e-12));
+    };
+    const std::size_t sj = in_.j.size();
+    part_.resize(nc * 3 * std::max(sj, stride_));
+    jb.split(leaf, 1, state, part_.data(), states.data(), scratch_);
+    for (std::size_t q = 0; q < nc; ++q) std::copy_n(part_.data() + q * sj, sj, children.data() + q * stride_);
+    child_err[0] = child_error(jb, err[0], leaf, sj);
+    for (std::size_t c = 0; c < dim_; ++c) {
+      const BernsteinBisection& cb = *col_tools_[c]->bisection;
+      const std::size_t block = 3 * size_[c];
+      const double* parent = leaf + offset_[c + 1];
+      column_states_.resize(nc);
+      cb.split(parent, 3, state, part_.data(), column_states_.data(), scratch_);
+      for (std::size_t q = 0; q < nc; ++q)
+        std::copy_n(part_.data() + q * block, block, children.data() + q * stride_ + offset_[c + 1]);
+      child_err[c + 1] = child_error(cb, err[c + 1], parent, block);
+    }
+  }
+
+  BisectionState root_state() const { return j_tools_->bisection->root_state(); }
+
+ private:
+  const ScaledJacobianSpace& space_;
+  const QuotientInput& in_;
+  std::size_t dim_ = 0, stride_ = 0;
+  const SpaceTools* j_tools_ = nullptr;
+  std::array<const SpaceTools*, 3> col_tools_{};
+  std::array<std::size_t, 4> offset_{};  // of J (0) and of column c (c + 1) in a leaf
+  std::array<std::size_t, 3> size_{};    // coefficients of column c, per coordinate
+  std::vector<std::array<FrameColumn, 3>> frames_;
+  const double gamma_ = rounding_gamma(6);  // of a frame column's sum of <= 3 columns
+  mutable std::vector<double> sumsq_, part_, scratch_;
+  mutable std::vector<BisectionState> column_states_;
+};
+
+}  // namespace
+
+QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
+                              int max_splits) {
+  QualityBounds out;
+  out.lower = -kInf;
+  out.upper = space.s_hi();
+  if (!(down(*std::min_element(in.j.begin(), in.j.end()) - in.j_error) > 0)) return out;
+  const Quotient q(space, in);
+  const std::size_t stride = q.stride();
+  thread_local std::vector<double> pool, children;
+  thread_local std::vector<std::array<double, 4>> pool_err;
+  thread_local std::vector<BisectionState> states, child_states;
+  thread_local std::vector<int> free_slots;
+  thread_local std::vector<Leaf> heap;
+  pool.resize(stride);
+  pool_err.assign(1, {});
+  states.assign(1, q.root_state());
+  free_slots.clear();
+  heap.clear();
+  q.root(pool.data(), pool_err[0]);
+
+  double settled = kInf;  // least lower bound of the leaves dropped as good enough
+  long next_id = 0;
+  const auto cmp = [](const Leaf& a, const Leaf& b) { return a.lower != b.lower ? a.lower > b.lower : a.id > b.id; };
+  const auto push = [&](int slot) {
+    const auto s = static_cast<std::size_t>(slot);
+    const double lo = q.bound(pool.data() + s * stride, pool_err[s], out.upper);
+    if (up(out.upper - lo) <= tol) {
+      settled = std::min(settled, lo);  // stays good enough: upper only decreases
+      free_slots.push_back(slot);
+      return;
+    }
+    heap.push_back({lo, slot, next_id++});
+    std::push_heap(heap.begin(), heap.end(), cmp);
+  };
+  push(0);
+  // The gap shrinks about linearly with the subdomain: a root far from the tolerance would
+  // need more splits than the products of the full bounds cost (measured on the shared
+  // curved meshes), so only a root within kReachable tolerances is refined.
+  if (!heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol) max_splits = 0;
+  thread_local std::vector<double> parent;
+  parent.resize(stride);
+  std::array<double, 4> child_err{};
+  while (!heap.empty()) {
+    const Leaf top = heap.front();
+    if (up(out.upper - std::min(top.lower, settled)) <= tol || out.subdivisions >= max_splits) break;
+    std::pop_heap(heap.begin(), heap.end(), cmp);
+    heap.pop_back();
+    ++out.subdivisions;
+    const auto ts = static_cast<std::size_t>(top.slot);
+    std::copy_n(pool.data() + ts * stride, stride, parent.data());  // its slot is reused below
+    const std::array<double, 4> parent_err = pool_err[ts];
+    const BisectionState parent_state = states[ts];
+    free_slots.push_back(top.slot);
+    q.split(parent.data(), parent_err, parent_state, children, child_states, child_err);
+    for (std::size_t c = 0; c < child_states.size(); ++c) {
+      int slot;
+      if (!free_slots.empty()) {
+        slot = free_slots.back();
+        free_slots.pop_back();
+      } else {
+        slot = static_cast<int>(pool_err.size());
+        pool.resize(pool.size() + stride);
+        pool_err.emplace_back();
+        states.emplace_back();
+      }
+      const auto s = static_cast<std::size_t>(slot);
+      std::copy_n(children.data() + c * stride, stride, pool.data() + s * stride);
+      pool_err[s] = child_err;
+      states[s] = child_states[c];
+      push(slot);
+    }
+  }
+  double lower = settled;
+  for (const Leaf& l : heap) lower = std::min(lower, l.lower);
+  out.lower = lower;
+  out.tolerance_met = up(out.upper - out.lower) <= tol;
+  return out;
+}
+
+}  // namespace quadval

@@ -1,0 +1,52 @@
+#pragma once
+// The first stage of the scaled-Jacobian bounds (scaled_jacobian.hpp) on a valid element:
+// sj from J and the frame columns alone, before the products of twice the degree.
+//
+// Where J > 0 on the element and |V_k| = J (3D, planar 2D, 1D), sj = min_k s J / prod_j
+// |v_kj|. On a subdomain, J >= J_lo (its least Bézier coefficient) and |v_kj| <= the largest
+// norm of its control points (the convex hull property; the norm is convex), so
+//   sj >= min_k s J_lo / prod_j max_i |V_kj,i|;
+// at a corner of a subdomain the coefficients are values, so sj there bounds sj(E) from
+// above. The bound is exact where J and the columns are constant (straight-sided simplices,
+// parallelograms, parallelepipeds), and its gap shrinks linearly with the subdomain: J and
+// the columns (degree n, far smaller than the degree 2n of N and D_k) are split best-first
+// by bisection, a few times at most, which settles most curved elements of real meshes.
+// Internal to src/analysis.
+//
+// Errors: every coefficient carries an a priori bound (its input's, plus the bisection's
+// rounding_relative() * max|parent| + rounding_absolute() per split); a frame column is a
+// sum of at most 3 columns with weights +-1, so each of its coordinates is within
+// e = sum (e_c + gamma_6 m_c) of the exact one, which moves a control point's norm by at
+// most sqrt(3) e; the norms' own rounding (a few ulps) is covered by a relative 1e-12, and
+// every bound is rounded outward.
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "analysis/scaled_jacobian_space.hpp"
+#include "quadval/bezier_basis.hpp"
+#include "quadval/quality_bounds.hpp"
+
+namespace quadval {
+
+/// J and the columns of one element in their own Bézier spaces, with their bounds.
+struct QuotientInput {
+  std::span<const double> j;                 ///< J's coefficients
+  const std::vector<FactorDegree>* j_degrees = nullptr;
+  double j_error = 0;                        ///< |computed - exact| per coefficient
+  /// Column c (c < dim), coordinate x: its coefficients.
+  std::array<std::array<std::span<const double>, 3>, 3> col{};
+  std::array<const std::vector<FactorDegree>*, 3> col_degrees{};
+  std::array<double, 3> col_error{0, 0, 0};  ///< per column, every coordinate
+  std::array<double, 3> col_magnitude{0, 0, 0};  ///< >= |every computed coefficient|
+};
+
+/// Certified bounds of sj(E) on an element where J > 0 is proven, refined by at most
+/// max_splits best-first splits of J and the columns until upper - lower <= tol.
+/// lower = -inf when the root's least J coefficient is not positive (then nothing is
+/// refined); subdivisions counts the splits; tolerance_met says whether the gap closed.
+QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
+                              int max_splits);
+
+}  // namespace quadval
