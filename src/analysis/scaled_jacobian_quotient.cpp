@@ -289,8 +289,8 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
   };
   push(0);
   // The gap shrinks about linearly with the subdomain: a root far from the tolerance would
-  // need more splits than the products of the full bounds cost (measured on the shared
-  // curved meshes), so only a root within kReachable tolerances is refined.
+  // need more splits than the products of the full bounds cost (scaled_jacobian.cpp,
+  // kQuotientSplits), so only a root within kReachable tolerances is refined.
   if (!heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol) max_splits = 0;
   thread_local std::vector<double> parent;
   parent.resize(stride);
