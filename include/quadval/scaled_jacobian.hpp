@@ -60,6 +60,12 @@
 /// is involved. Every coefficient carries an a priori bound on its rounding error (the
 /// map's row sums, the products' convex weights, the averages of the bisections), and
 /// every bound is rounded outward.
+/// First, on an element where J > 0 is proven and |V_k| = J (3D, planar 2D, 1D), a
+/// cheaper stage bounds sj >= s J_lo / prod_j max_i |V_kj,i| from J and the frame columns in
+/// their own degrees (convex hull), exact on straight-sided simplices and parallelepipeds;
+/// it settles the straight and barely curved elements that make up most of a curved mesh,
+/// and its bounds tighten the ones below when it does not (src/analysis/
+/// scaled_jacobian_quotient.hpp).
 /// upper is the minimum of sj at points (the corners of the subdomains, where a Bézier
 /// coefficient is a value), rounded up by their error bounds. Refinement is best-first
 /// (the subdomain with the smallest lower bound is split into 2^dim children by edge
