@@ -161,11 +161,56 @@ bool vertex_value_invalid(const BezierBasis& basis, const double* coeffs, double
   return invalid;
 }
 
+// The validity answer when the first coefficients decide it, in one pass over them: a
+// vertex value J <= 0 proven (invalid, stage 0) or every coefficient proven positive
+// (valid, stage 1), nearly every element of a mesh. The same bounds, bit for bit, as
+// bounds_from_first_coefficients computes for these cases (the same sums and extrema in the
+// same order; refine_minimum returns its root bounds without splitting); false when a
+// refinement is needed, or a coefficient is not finite.
+bool decided_by_first_coefficients(const BezierBasis& basis, const double* coeffs, double err,
+                                   JacobianBounds& out) {
+  const auto s = static_cast<std::size_t>(basis.size());
+  double lo = coeffs[0], hi = -kInf, sum = 0;
+  for (std::size_t i = 0; i < s; ++i) {
+    sum += coeffs[i];
+    lo = std::min(lo, coeffs[i]);
+    hi = std::max(hi, coeffs[i]);
+  }
+  double vertex_lo = kInf, vertex_hi = -kInf, value_upper = kInf;
+  bool invalid = false;
+  for (int v : basis.vertex_indices()) {
+    const double c = coeffs[static_cast<std::size_t>(v)];
+    const double value_hi = up(c + err);
+    value_upper = std::min(value_upper, value_hi);
+    if (value_hi <= 0) invalid = true;
+    vertex_lo = std::min(vertex_lo, c);
+    vertex_hi = std::max(vertex_hi, c);
+  }
+  if (!std::isfinite(sum) || !std::isfinite(lo) || !std::isfinite(hi)) return false;
+  const double jmin_lower = down(lo - err);
+  if (!invalid && !(jmin_lower > 0)) return false;
+  out.javg = sum / static_cast<double>(s);
+  out.jmin_lower = jmin_lower;
+  out.jmin_upper = std::min(up(vertex_lo + err), value_upper);
+  out.jmax_upper = up(hi + err);
+  out.jmax_lower = down(vertex_hi - err);
+  out.subdivisions = 0;
+  out.tolerance_met = true;
+  out.exact = false;
+  out.validity = invalid ? Validity::invalid : Validity::valid;
+  out.stage = invalid ? 0 : 1;
+  return true;
+}
+
 }  // namespace
 
 JacobianBounds bounds_from_coefficients(const JacobianSpace& space, const double* coeffs,
                                         double err, const double* nodes, bool planar,
                                         const BoundsOptions& options, BoundsWorkspace::Impl& ws) {
+  if (options.goal == BoundsGoal::validity) {
+    JacobianBounds out;
+    if (decided_by_first_coefficients(space.basis(), coeffs, err, out)) return out;
+  }
   const auto s = static_cast<std::size_t>(space.basis().size());
   ws.coeffs.assign(coeffs, coeffs + s);
   double value_upper = kInf;

@@ -104,9 +104,11 @@ Eigen::Matrix3d rotation(double a, double b) {
 }
 
 TEST(MuPyramid, SupportedForEveryOrderOfTheJacobianBounds) {
-  for (const ElementType& t : element_types())
-    if (t.family == ElementFamily::pyramid && t.has_lagrange_basis && t.order >= 1)
+  for (const ElementType& t : element_types()) {
+    if (t.family == ElementFamily::pyramid && t.has_lagrange_basis && t.order >= 1) {
       EXPECT_EQ(mu_supported(t), jacobian_bounds_supported(t)) << t.name;
+    }
+  }
   EXPECT_TRUE(mu_supported(*find_element_type(118)));  // order 3
 }
 
@@ -143,7 +145,9 @@ TEST(MuPyramid, AffineImageOfTheIdealGivesTheRatioOfItsStretches) {
         a << 1, 0.4, -0.3, 0.1, 0.8, 0.5, 0.2, -0.1, 1.3;
       }
       const double want = ratio_of_singular_values(a);
-      if (k < 5) EXPECT_NEAR(want, s.minCoeff() / s.maxCoeff(), 1e-14);
+      if (k < 5) {
+        EXPECT_NEAR(want, s.minCoeff() / s.maxCoeff(), 1e-14);
+      }
       for (bool constant_path : {true, false}) {
         mu_use_constant_path(constant_path);
         SCOPED_TRACE(std::string(t->name) + " k " + std::to_string(k) + (constant_path ? " closed" : " subdivision"));
