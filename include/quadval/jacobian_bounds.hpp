@@ -59,6 +59,9 @@ struct BoundsOptions {
   int max_subdivisions = 1000;
   /// Redo an element in exact rational arithmetic when rounding keeps its sign open.
   bool exact_fallback = true;
+  /// validity: answer in one pass over the first Bézier coefficients when they decide it
+  /// (bit-identical to the general path, which tests compare it with by turning this off).
+  bool one_pass_decision = true;
 };
 
 struct JacobianBounds {

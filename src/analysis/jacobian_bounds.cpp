@@ -207,7 +207,7 @@ bool decided_by_first_coefficients(const BezierBasis& basis, const double* coeff
 JacobianBounds bounds_from_coefficients(const JacobianSpace& space, const double* coeffs,
                                         double err, const double* nodes, bool planar,
                                         const BoundsOptions& options, BoundsWorkspace::Impl& ws) {
-  if (options.goal == BoundsGoal::validity) {
+  if (options.goal == BoundsGoal::validity && options.one_pass_decision) {
     JacobianBounds out;
     if (decided_by_first_coefficients(space.basis(), coeffs, err, out)) return out;
   }

@@ -49,7 +49,9 @@ void expect_identical(const JacobianBounds& a, const JacobianBounds& b, const st
 }
 
 // check_mesh against jacobian_bounds, element by element, in both goals. 300 elements: a
-// full chunk of 256 and a partial one, whose 44 = 5 lane blocks of 8 + a tail of 4.
+// full chunk of 256 and a partial one, whose 44 = 5 lane blocks of 8 + a tail of 4. The
+// single-element bounds take the general path even where check decides in one pass over
+// the first coefficients (BoundsOptions::one_pass_decision), so that is compared too.
 void compare(CheckMeasure measure, std::size_t count, unsigned seed) {
   std::mt19937 rng(seed);
   std::size_t answers[3] = {0, 0, 0}, subdivided = 0;
@@ -67,6 +69,7 @@ void compare(CheckMeasure measure, std::size_t count, unsigned seed) {
     ASSERT_EQ(r.elements.size(), count);
     BoundsOptions bo;
     bo.goal = measure == CheckMeasure::validity ? BoundsGoal::validity : BoundsGoal::measure;
+    bo.one_pass_decision = false;  // the general path, against check's one-pass decision
     BoundsWorkspace ws;
     const bool planar = type->dim == 2;  // random_element puts 2D elements in z = 0
     for (std::size_t e = 0; e < count; ++e) {

@@ -147,7 +147,9 @@ TEST_P(DenseSamplingTest, SampledExtremaInsideBounds) {
     const JacobianBounds v = jacobian_bounds(type, x, BoundsOptions{}, ws, planar);
     ASSERT_LE(v.jmin_lower, smin + slack) << type.name << " element " << e;
     ASSERT_GE(v.jmax_upper, smax - slack) << type.name << " element " << e;
-    if (smin < -slack) ASSERT_NE(v.validity, Validity::valid) << type.name << " element " << e;
+    if (smin < -slack) {
+      ASSERT_NE(v.validity, Validity::valid) << type.name << " element " << e;
+    }
     ++kinds[static_cast<int>(v.validity)];
     const JacobianBounds m = jacobian_bounds(type, x, measure, ws, planar);
     ASSERT_LE(m.jmin_lower, smin + slack) << type.name << " element " << e;
@@ -160,8 +162,9 @@ TEST_P(DenseSamplingTest, SampledExtremaInsideBounds) {
       EXPECT_LE(m.jmax_upper - m.jmax_lower, tol * 1.0001);
     }
     // validity agrees between the two goals whenever both decided
-    if (m.validity != Validity::undetermined && v.validity != Validity::undetermined)
+    if (m.validity != Validity::undetermined && v.validity != Validity::undetermined) {
       EXPECT_EQ(m.validity, v.validity);
+    }
   }
   EXPECT_GT(kinds[0], 0) << type.name << ": no valid element in the random set";
 }
