@@ -100,13 +100,22 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
     const auto hi = simplex_multi_indices(d, nu + mu);
     std::map<MultiIndex, int> h_index;
     for (std::size_t k = 0; k < hi.size(); ++k) h_index[hi[k]] = static_cast<int>(k);
+    // The multinomials of every multi-index, once (not per pair).
+    const auto multinomials = [d](const std::vector<MultiIndex>& list) {
+      std::vector<mpz_class> out;
+      out.reserve(list.size());
+      for (const MultiIndex& a : list) out.push_back(multinomial(a, d));
+      return out;
+    };
+    const std::vector<mpz_class> f_alpha = multinomials(fi), g_alpha = multinomials(gi), h_alpha = multinomials(hi);
     std::vector<int> terms(hi.size(), 0);
     for (std::size_t i = 0; i < fi.size(); ++i)
       for (std::size_t j = 0; j < gi.size(); ++j) {
         MultiIndex k{};
         for (std::size_t a = 0; a < 4; ++a) k[a] = fi[i][a] + gi[j][a];
         const int kk = h_index.at(k);
-        const mpq_class w(multinomial(fi[i], d) * multinomial(gi[j], d), multinomial(k, d));
+        mpq_class w(f_alpha[i] * g_alpha[j], h_alpha[static_cast<std::size_t>(kk)]);
+        w.canonicalize();
         entries_[fac].push_back({static_cast<int>(i), static_cast<int>(j), kk, nearest_double(mpq_class(w))});
         exact_w[fac].push_back(w);
         ++terms[static_cast<std::size_t>(kk)];
@@ -181,8 +190,12 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
   if (entries_kernel_) {
     // Flattened entry kernel: every (i, j) pair with its exact tensor weight, by k.
     std::vector<std::vector<Pair>> rows(static_cast<std::size_t>(h_size_));
+    // The exact tensor weight w0 w1 w2, with w1 w2 formed once per (a1, a2) and the unit
+    // weights of unused factors not multiplied at all (GMP products are most of the set-up).
     for (std::size_t a2 = 0; a2 < entries_[2].size(); ++a2)
-      for (std::size_t a1 = 0; a1 < entries_[1].size(); ++a1)
+      for (std::size_t a1 = 0; a1 < entries_[1].size(); ++a1) {
+        const mpq_class w12 = exact_w[1][a1] * exact_w[2][a2];
+        const bool unit = w12 == 1;
         for (std::size_t a0 = 0; a0 < entries_[0].size(); ++a0) {
           const Entry& e0 = entries_[0][a0];
           const Entry& e1 = entries_[1][a1];
@@ -190,9 +203,10 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
           const int i = e0.i * f_stride_[0] + e1.i * f_stride_[1] + e2.i * f_stride_[2];
           const int j = e0.j * g_stride_[0] + e1.j * g_stride_[1] + e2.j * g_stride_[2];
           const int k = e0.k * h_stride_[0] + e1.k * h_stride_[1] + e2.k * h_stride_[2];
-          const mpq_class w = exact_w[0][a0] * exact_w[1][a1] * exact_w[2][a2];
-          rows[static_cast<std::size_t>(k)].push_back({i, j, nearest_double(w)});
+          const double w = unit ? e0.w : nearest_double(mpq_class(exact_w[0][a0] * w12));
+          rows[static_cast<std::size_t>(k)].push_back({i, j, w});
         }
+      }
     row_start_.push_back(0);
     for (const auto& r : rows) {
       pairs_.insert(pairs_.end(), r.begin(), r.end());

@@ -3,6 +3,7 @@
 // arithmetic (Bézier conversions, derivative maps, products). Internal to src/.
 #include <gmpxx.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -26,11 +27,18 @@ inline double round_up(const mpq_class& q) {
   return d;
 }
 
-/// The double nearest to q (either one on a tie): |result - q| <= u |q|, u = 2^-53, in
+/// The double nearest to q (the lower one on a tie): |result - q| <= u |q|, u = 2^-53, in
 /// the normal range. Error bounds built on these tables may assume that much.
+/// GMP's get_d truncates toward zero, so q lies in [d, e), e the next double away from
+/// zero; q is then compared once with their midpoint (exact: a sum of two doubles).
 inline double nearest_double(const mpq_class& q) {
-  const double lo = round_down(q), hi = round_up(q);
-  return mpq_class(q - mpq_class(lo)) <= mpq_class(mpq_class(hi) - q) ? lo : hi;
+  const double d = q.get_d();
+  const mpq_class dq(d);
+  if (cmp(dq, q) == 0) return d;  // cmp, not ==: q need not be canonical
+  const double e = std::nextafter(d, sgn(q) > 0 ? std::numeric_limits<double>::infinity()
+                                                : -std::numeric_limits<double>::infinity());
+  const double lo = std::min(d, e), hi = std::max(d, e);
+  return mpq_class(2 * q) <= mpq_class(dq + mpq_class(e)) ? lo : hi;
 }
 
 }  // namespace quadval
