@@ -29,8 +29,9 @@ inline double round_up(const mpq_class& q) {
 
 /// The double nearest to q (the lower one on a tie): |result - q| <= u |q|, u = 2^-53, in
 /// the normal range. Error bounds built on these tables may assume that much.
-/// GMP's get_d truncates toward zero, so q lies in [d, e), e the next double away from
-/// zero; q is then compared once with their midpoint (exact: a sum of two doubles).
+/// GMP's get_d truncates toward zero: q is d or lies strictly between d and e, the next
+/// double away from zero; it is then compared once with their midpoint (exact: a sum of two
+/// doubles). tests/bezier/rational_rounding_test.cpp checks it against the definition.
 inline double nearest_double(const mpq_class& q) {
   const double d = q.get_d();
   const mpq_class dq(d);
