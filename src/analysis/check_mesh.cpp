@@ -4,6 +4,7 @@
 // Chunks are grouped in batches of kCheckBatch elements: one batch of results exists at a
 // time, handed to the sink and folded into the summary before the next one starts, so the
 // memory beyond the mesh does not grow with it.
+#include <fmt/format.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -76,6 +77,22 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   report.dimension = mesh.dimension();
   for (double c : mesh.coords)
     if (!std::isfinite(c)) throw InputError::in_file(file, "a node coordinate is not finite");
+  // J multiplies three lengths, and mu and the scaled Jacobian square it (N = J^2, D_k =
+  // prod |v|^2): beyond this span they would overflow double precision, and no bound
+  // printed could be a true one.
+  constexpr double kMaxSpan = 1e40;
+  for (std::size_t axis = 0; axis < 3 && !mesh.coords.empty(); ++axis) {
+    double lo = mesh.coords[axis], hi = lo;
+    for (std::size_t i = axis; i < mesh.coords.size(); i += 3) {
+      lo = std::min(lo, mesh.coords[i]);
+      hi = std::max(hi, mesh.coords[i]);
+    }
+    if (hi - lo > kMaxSpan)
+      throw InputError::in_file(file, fmt::format("the node coordinates span {:g} along an axis, beyond {:g}: J and "
+                                                  "the squared quantities of mu and the scaled Jacobian (six lengths "
+                                                  "multiplied) would overflow double precision; rescale the mesh",
+                                                  hi - lo, kMaxSpan));
+  }
 
   // Planar 2D: every node of every 2D block has the same z.
   if (report.dimension == 2) {

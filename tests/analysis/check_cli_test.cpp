@@ -113,6 +113,14 @@ TEST_F(CheckCli, BadInputExitsTwo) {
   EXPECT_NE(r.output.find("garbage.msh"), std::string::npos) << r.output;
   EXPECT_EQ(run_cli("check " + data_ + "quad_h0.4_o2.msh -o " + (dir_ / "x.txt").string()).code, 2);
   EXPECT_EQ(run_cli("check " + data_ + "quad_h0.4_o2.msh --measure nonsense").code, 2);
+  // Coordinates so far apart that J would overflow: refused, rather than bounds of inf.
+  const fs::path huge = dir_ / "huge.msh";
+  std::ofstream(huge) << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 1e150 0 0\n"
+                         "3 0 1e150 0\n4 0 0 1e150\n$EndNodes\n$Elements\n1\n1 4 2 0 1 1 2 3 4\n$EndElements\n";
+  const CliRun h = run_cli("check " + huge.string() + " --measure all");
+  EXPECT_EQ(h.code, 2) << h.output;
+  EXPECT_NE(h.output.find("huge.msh"), std::string::npos) << h.output;
+  EXPECT_NE(h.output.find("rescale"), std::string::npos) << h.output;
 }
 
 // An element whose order is beyond the supported ones is skipped, said so, and keeps the
