@@ -121,7 +121,6 @@ class Quotient {
   }
 
   std::size_t stride() const { return stride_; }
-  std::size_t dim() const { return dim_; }
 
   // The root leaf, into `leaf` (stride() doubles) and its errors.
   void root(double* leaf, std::array<double, 4>& err) const {
@@ -219,7 +218,7 @@ class Quotient {
       return up((e + b.rounding_relative() * m + b.rounding_absolute()) * (1 + 1e-12));
     };
     const std::size_t sj = in_.j.size();
-    part_.resize(nc * 3 * std::max(sj, stride_));
+    part_.resize(nc * stride_);  // any one part's children: stride_ >= J's and 3 x a column's size
     jb.split(leaf, 1, state, part_.data(), states.data(), scratch_);
     for (std::size_t q = 0; q < nc; ++q) std::copy_n(part_.data() + q * sj, sj, children.data() + q * stride_);
     child_err[0] = child_error(jb, err[0], leaf, sj);

@@ -86,6 +86,19 @@ double sj_at(const ElementType& type, const std::vector<double>& x, const RefPoi
   }
 }
 
+// The unit chord from node 0 to node 1 (the 1D reference direction of the tests' elements).
+Vec chord(const std::vector<double>& x) {
+  const Vec d = {x[3] - x[0], x[4] - x[1], x[5] - x[2]};
+  return Vec{d[0] / norm(d), d[1] / norm(d), d[2] / norm(d)};
+}
+
+// The least pointwise sj at the points (planar 2D: n = +z).
+double sampled_min(const ElementType& t, const std::vector<double>& x, const std::vector<RefPoint>& pts) {
+  double m = INFINITY;
+  for (const RefPoint& p : pts) m = std::min(m, sj_at(t, x, p, {0, 0, 1}, chord(x)));
+  return m;
+}
+
 QualityBounds bounds(const ElementType& t, const std::vector<double>& x, double tol = 1e-6,
                      bool planar = true) {
   QualityOptions o;
@@ -300,11 +313,7 @@ TEST(ScaledJacobian, FirstStageIsExactOnStraightElements) {
     SCOPED_TRACE(std::string(t.name));
     for (int e = 0; e < 5; ++e) {
       const std::vector<double> x = test::random_element(t, 0.0, rng);
-      const Vec tangent = [&] {
-        const Vec d = {x[3] - x[0], x[4] - x[1], x[5] - x[2]};
-        return Vec{d[0] / norm(d), d[1] / norm(d), d[2] / norm(d)};
-      }();
-      const double want = sj_at(t, x, reference_nodes(t)[0], {0, 0, 1}, tangent);
+      const double want = sj_at(t, x, reference_nodes(t)[0], {0, 0, 1}, chord(x));
       const QualityBounds b = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1.0, 0);
       EXPECT_LE(b.lower, want + 1e-12);
       EXPECT_GE(b.upper, want - 1e-12);
@@ -339,13 +348,7 @@ TEST(ScaledJacobian, FirstStageBoundsEncloseSampledAndFullBounds) {
       EXPECT_LE(full.lower, first.upper) << "element " << e;
       EXPECT_LE(first.lower, full.upper) << "element " << e;
       if (t.family != ElementFamily::pyramid) {
-        const Vec tangent = [&] {
-          const Vec d = {x[3] - x[0], x[4] - x[1], x[5] - x[2]};
-          return Vec{d[0] / norm(d), d[1] / norm(d), d[2] / norm(d)};
-        }();
-        double sampled = INFINITY;
-        for (const RefPoint& p : pts) sampled = std::min(sampled, sj_at(t, x, p, {0, 0, 1}, tangent));
-        EXPECT_LE(first.lower, sampled + 1e-12) << "element " << e;
+        EXPECT_LE(first.lower, sampled_min(t, x, pts) + 1e-12) << "element " << e;
       }
       ++elements;
       if (amplitude == 1e-3) {
@@ -381,13 +384,7 @@ TEST(ScaledJacobian, FirstStageRefinedEnclosesAndConverges) {
       EXPECT_LE(q.subdivisions, 16);
       EXPECT_GE(q.lower, root.lower) << "element " << e;  // refining never loosens
       if (t.family != ElementFamily::pyramid) {
-        const Vec tangent = [&] {
-          const Vec d = {x[3] - x[0], x[4] - x[1], x[5] - x[2]};
-          return Vec{d[0] / norm(d), d[1] / norm(d), d[2] / norm(d)};
-        }();
-        double sampled = INFINITY;
-        for (const RefPoint& p : pts) sampled = std::min(sampled, sj_at(t, x, p, {0, 0, 1}, tangent));
-        EXPECT_LE(q.lower, sampled + 1e-12) << "element " << e;
+        EXPECT_LE(q.lower, sampled_min(t, x, pts) + 1e-12) << "element " << e;
       }
       if (q.tolerance_met) {
         EXPECT_LE(q.upper - q.lower, 1e-2);
