@@ -63,15 +63,17 @@ struct Scratch {
 };
 
 // Bounds the quantities of one subdomain (or one point) need: vectors J, N, D_0..D_{K-1}
-// of `size` coefficients each at v[q * size], their error bounds err[q].
+// of `size` coefficients each at v[q * size], their error bounds err[q]; then, for the
+// frames given a Hadamard pair (hadamard[k] = q >= 0), H_k at q and G_k at q + 1.
 class Bounder {
  public:
   /// valid: J > 0 is proven on the whole element (jacobian_bounds), so every subdomain
   /// takes the positive branch without its own coefficient test. signed_volume: |V_k| = |J|
   /// (3D, planar 2D, 1D), so that sj = s J / sqrt(D_k); not for surface elements in 3D.
-  Bounder(const ScaledJacobianSpace& space, std::size_t size, bool valid, bool signed_volume)
+  Bounder(const ScaledJacobianSpace& space, std::size_t size, bool valid, bool signed_volume,
+          std::vector<int> hadamard)
       : space_(space), size_(size), frames_(space.frames().size()), valid_(valid),
-        signed_volume_(signed_volume) {}
+        signed_volume_(signed_volume), hadamard_(std::move(hadamard)) {}
 
   // Certified lower bound of sj on the subdomain (see scaled_jacobian.hpp).
   double lower(const double* v, const double* err) const {
@@ -93,40 +95,38 @@ class Bounder {
       }
       return down(space_.s_lo() * down(std::sqrt(std::max(0.0, r))));
     }
-    // J not proven positive: sj >= -s sqrt(max N / D_k), and |sj| <= s (Hadamard).
-    double ub = 0;
-    for (std::size_t k = 0; k < frames_ && ub <= 1; ++k) {
-      const double* d = v + (2 + k) * size_;
-      const double ed = err[2 + k];
-      for (std::size_t i = 0; i < size_; ++i) {
-        const double d_lo = down(d[i] - ed);
-        if (!(d_lo > 0)) {
-          ub = 1;
-          break;
-        }
-        ub = std::max(ub, up(std::max(0.0, up(n[i] + err[1])) / d_lo));
-      }
-    }
-    ub = std::min(ub, 1.0);
-    const double squared = -up(space_.s_hi() * up(std::sqrt(ub)));
-    return signed_volume_ ? std::max(squared, signed_lower(v, err)) : squared;
-  }
-
-  // Where sj = s J / sqrt(D_k): sj >= 0 where J >= 0, and where J < 0, J >= J_lo (the
-  // least coefficient of J, convex hull) and sqrt(D_k) >= sqrt(D_k,lo) (the least of D_k),
-  // so sj >= s J_lo / sqrt(D_k,lo). Unlike the bound from N = J^2, it does not count the
-  // |sj| of the part where J > 0: on a subdomain across the fold, where the positive part
-  // dominates max N / D_k, it is the sharper one (warped_prism_o2_N6_a0.25: 6274 -> 848
-  // subdivisions, at most 15 instead of 414 per element).
-  double signed_lower(const double* v, const double* err) const {
-    const double j_lo = down(*std::min_element(v, v + size_) - err[0]);
-    if (j_lo >= 0) return 0;
-    double out = 0;
+    // J not proven positive: per frame, the best of the bounds below; sj is their minimum.
+    const double j_lo = down(*std::min_element(j, j + size_) - err[0]);
+    double out = kInf;
     for (std::size_t k = 0; k < frames_; ++k) {
       const double* d = v + (2 + k) * size_;
-      const double d_lo = down(*std::min_element(d, d + size_) - err[2 + k]);
-      if (!(d_lo > 0)) return floor();
-      out = std::min(out, -up(space_.s_hi() * up(-j_lo / down(std::sqrt(d_lo)))));
+      const double ed = err[2 + k];
+      // sj_k >= -s sqrt(max_i N_i / D_k,i), all D_k,i > 0 (relaxation), and >= -s.
+      double ratio = std::min(1.0, max_ratio(n, err[1], d, ed));
+      // Hadamard with column a divided out: |V_k| <= |v_a| |v_b x v_c|, so
+      // sj_k >= -s |v_b x v_c| / (|v_b| |v_c|) = -s sqrt(H_k / G_k) wherever v_a != 0
+      // (and sj = 0 where it vanishes): sharp around a point of a fold where v_a = 0.
+      if (hadamard_[k] >= 0) {
+        const auto q = static_cast<std::size_t>(hadamard_[k]);
+        ratio = std::min(ratio, max_ratio(v + q * size_, err[q], v + (q + 1) * size_, err[q + 1]));
+      }
+      double best = -up(space_.s_hi() * up(std::sqrt(ratio)));
+      // Where sj_k = s J / sqrt(D_k): sj_k >= 0 where J >= 0, and where J < 0, J >= J_lo
+      // (the least coefficient of J, convex hull) and sqrt(D_k) >= sqrt(D_k,lo), so
+      // sj_k >= s J_lo / sqrt(D_k,lo). Unlike the bound from N = J^2, it does not count
+      // the |sj| of the part where J > 0: on a subdomain across the fold, where the
+      // positive part dominates max N / D_k, it is the sharper one
+      // (warped_prism_o2_N6_a0.25: 6274 -> 848 subdivisions, at most 15 instead of 414
+      // per element).
+      if (signed_volume_) {
+        if (j_lo >= 0) {
+          best = 0;
+        } else {
+          const double d_lo = down(*std::min_element(d, d + size_) - ed);
+          if (d_lo > 0) best = std::max(best, -up(space_.s_hi() * up(-j_lo / down(std::sqrt(d_lo)))));
+        }
+      }
+      out = std::min(out, best);
     }
     return out;
   }
@@ -137,20 +137,20 @@ class Bounder {
   // True when no subdomain inside this one can ever get a lower bound above floor():
   // (1) at one of its vertices J <= 0 is certified, so every subdomain holding that vertex
   // fails the sign test (J > 0 is not proven there), and (2) for some frame k every
-  // computed coefficient of D_k is at most its error bound: bisection never raises the
-  // largest coefficient nor lowers the error bound (bernstein_bisection.hpp), so D_k is
-  // never proven positive inside either, and the non-positive branch stays at the floor.
-  // This is what happens around a point where a frame column vanishes inside a fold:
-  // there D_k = 0, sj has no limit, and the subdivision only zooms in on that point.
+  // computed coefficient of D_k (and of G_k, if it has a Hadamard pair) is at most its
+  // error bound: bisection never raises the largest coefficient nor lowers the error
+  // bound (bernstein_bisection.hpp), so D_k (G_k) is never proven positive inside either,
+  // and that frame stays at the floor. This is what happens around a point where two
+  // columns of a frame vanish inside a fold (or one, without a Hadamard pair): there sj has
+  // no limit, and the subdivision only zooms in on that point.
   bool stuck_at_floor(const double* v, const double* err, std::span<const int> vertices) const {
     if (valid_) return false;
     bool nonpositive_vertex = false;
     for (int i : vertices) nonpositive_vertex = nonpositive_vertex || up(v[i] + err[0]) <= 0;
     if (!nonpositive_vertex) return false;
-    for (std::size_t k = 0; k < frames_; ++k) {
-      const double* d = v + (2 + k) * size_;
-      if (*std::max_element(d, d + size_) <= err[2 + k]) return true;
-    }
+    const auto vanishes = [&](std::size_t q) { return *std::max_element(v + q * size_, v + (q + 1) * size_) <= err[q]; };
+    for (std::size_t k = 0; k < frames_; ++k)
+      if (vanishes(2 + k) && (hadamard_[k] < 0 || vanishes(static_cast<std::size_t>(hadamard_[k]) + 1))) return true;
     return false;
   }
 
@@ -179,10 +179,23 @@ class Bounder {
   }
 
  private:
+  // max_i num_i / den_i rounded up (num_i clamped at 0), or 1 (no bound) unless every
+  // den_i is proven positive.
+  double max_ratio(const double* num, double num_err, const double* den, double den_err) const {
+    double r = 0;
+    for (std::size_t i = 0; i < size_; ++i) {
+      const double den_lo = down(den[i] - den_err);
+      if (!(den_lo > 0)) return 1;
+      r = std::max(r, up(std::max(0.0, up(num[i] + num_err)) / den_lo));
+    }
+    return r;
+  }
+
   const ScaledJacobianSpace& space_;
   std::size_t size_, frames_;
   bool valid_;
   bool signed_volume_;
+  std::vector<int> hadamard_;  // per frame: index of H_k (G_k follows), or -1
 };
 
 // A coefficient vector with its bounds: |entries| <= m (computed), |entry - exact| <= e.
@@ -281,8 +294,10 @@ void frame_column(const Frame& fr, std::size_t j, std::size_t dim, const Columns
 struct Polys {
   Columns col;
   std::array<Poly, 3> w, v;
-  Poly jac, n, jsq, one, sq, prod, tmp;
-  std::vector<Poly> dk;
+  Poly jac, n, jsq, one, prod, tmp;
+  std::array<std::array<Poly, 3>, 3> frame_col;  // one frame's columns [j][coordinate]
+  std::array<Poly, 3> frame_sq;                  // their squared norms
+  std::vector<Poly> dk, hadamard;                // per frame: D_k; H_k, G_k
 };
 
 // The quotient stage's view of an element's J and columns (scaled_jacobian_quotient.hpp).
@@ -403,7 +418,6 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   const int dim = type.dim;
   const auto udim = static_cast<std::size_t>(dim);
   const std::size_t frames = space.frames().size();
-  const std::size_t nvec = 2 + frames;
 
   thread_local Polys polys;
   auto& col = polys.col;
@@ -441,29 +455,73 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   }
   auto& dk = polys.dk;
   dk.resize(frames);
+  // An element not proven valid may hold a point of a fold where a frame column vanishes;
+  // there D_k = 0, and only the Hadamard bound (Bounder::lower) with that column divided
+  // out stays sharp. A frame whose D_k is not proven positive at the root gets that bound
+  // for its column most likely to vanish: H = |v_b x v_c|^2 and G = |v_b|^2 |v_c|^2, both
+  // times 1 in the space of |v_a|^2 to reach the squared space (3D only: in 2D |V_k| =
+  // |v_a| |v_b| sin, and dividing out leaves nothing below -s).
+  const bool hadamard_frames = v != Validity::valid && dim == 3;
+  std::vector<int> hadamard(frames, -1);
+  std::size_t nvec = 2 + frames;
+  auto& had = polys.hadamard;
+  had.resize(2 * frames);
   for (std::size_t f = 0; f < frames; ++f) {
     const Frame& fr = space.frames()[f];
-    Poly& prod = polys.prod;
+    auto& vj = polys.frame_col;
+    auto& sq = polys.frame_sq;
     for (std::size_t j = 0; j < udim; ++j) {
-      auto& vj = polys.v;
-      frame_column(fr, j, udim, col, vj);
-      Poly& sq = j == 0 ? prod : polys.sq;
-      product_sum({{&vj[0], &vj[0], 1.0}, {&vj[1], &vj[1], 1.0}, {&vj[2], &vj[2], 1.0}}, sq);
-      if (j > 0) {
-        product_sum({{&prod, &sq, 1.0}}, polys.tmp);
+      frame_column(fr, j, udim, col, vj[j]);
+      product_sum({{&vj[j][0], &vj[j][0], 1.0}, {&vj[j][1], &vj[j][1], 1.0}, {&vj[j][2], &vj[j][2], 1.0}}, sq[j]);
+    }
+    Poly& prod = polys.prod;
+    if (udim == 1) {
+      prod = sq[0];
+    } else {
+      product_sum({{&sq[0], &sq[1], 1.0}}, prod);
+      if (udim == 3) {
+        product_sum({{&prod, &sq[2], 1.0}}, polys.tmp);
         std::swap(prod, polys.tmp);
       }
     }
     std::swap(dk[f], prod);
+    const auto least = [](const Poly& p) { return *std::min_element(p.c.begin(), p.c.end()) - p.b.e; };
+    if (!hadamard_frames || least(dk[f]) > 0) continue;
+    // Column a: the least lower bound of |v_a|^2 relative to its size.
+    std::size_t a = 0;
+    for (std::size_t j = 1; j < 3; ++j)
+      if (least(sq[j]) * std::max(sq[a].b.m, 1e-300) < least(sq[a]) * std::max(sq[j].b.m, 1e-300)) a = j;
+    const std::size_t b = (a + 1) % 3, c = (a + 2) % 3;
+    auto& cr = polys.w;
+    for (std::size_t x = 0; x < 3; ++x) {  // v_b x v_c
+      const std::size_t y = (x + 1) % 3, z = (x + 2) % 3;
+      product_sum({{&vj[b][y], &vj[c][z], 1.0}, {&vj[b][z], &vj[c][y], -1.0}}, cr[x]);
+    }
+    Poly& one = polys.one;
+    one.deg = sq[a].deg;
+    one.c.assign(sq[a].c.size(), 1.0);
+    one.b = {1, 0};
+    product_sum({{&cr[0], &cr[0], 1.0}, {&cr[1], &cr[1], 1.0}, {&cr[2], &cr[2], 1.0}}, polys.tmp);
+    product_sum({{&polys.tmp, &one, 1.0}}, had[2 * f]);
+    product_sum({{&sq[b], &sq[c], 1.0}}, polys.tmp);
+    product_sum({{&polys.tmp, &one, 1.0}}, had[2 * f + 1]);
+    hadamard[f] = static_cast<int>(nvec);
+    nvec += 2;
   }
 
   // 3. The root: vectors J, N, D_k in the squared space, slot 0 of the leaf pool.
   const std::size_t stride = nvec * s2;
   ws.pool.assign(stride, 0.0);
   ws.pool_err.assign(nvec, 0.0);
-  const std::array<const Poly*, 2> jn = {&jsq, &n};
+  std::vector<const Poly*> vectors = {&jsq, &n};
+  for (const Poly& d : dk) vectors.push_back(&d);
+  for (std::size_t f = 0; f < frames; ++f)
+    if (hadamard[f] >= 0) {
+      vectors.push_back(&had[2 * f]);
+      vectors.push_back(&had[2 * f + 1]);
+    }
   for (std::size_t q = 0; q < nvec; ++q) {
-    const Poly& p = q < 2 ? *jn[q] : dk[q - 2];
+    const Poly& p = *vectors[q];
     QV_ASSERT(p.c.size() == s2 && p.deg.size() == space.squared_degrees().size(), "squared space");
     for (std::size_t f = 0; f < p.deg.size(); ++f)
       QV_ASSERT(p.deg[f].degree == space.squared_degrees()[f].degree, "squared degree");
@@ -475,7 +533,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   ws.states.assign(1, b2.root_state());
   // valid lets every subdomain skip its own sign test (the J vector is then a
   // placeholder); invalid means a point with J <= 0, where sj <= 0.
-  Bounder bounder(space, s2, v == Validity::valid, !area);
+  Bounder bounder(space, s2, v == Validity::valid, !area, std::move(hadamard));
   double upper = v == Validity::invalid ? 0.0 : space.s_hi();
 
   const double tol = options.abs_tol;
