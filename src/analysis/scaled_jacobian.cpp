@@ -179,16 +179,22 @@ class Bounder {
   }
 
  private:
-  // max_i num_i / den_i rounded up (num_i clamped at 0), or 1 (no bound) unless every
-  // den_i is proven positive.
+  // An upper bound of max_i (num_i + num_err) / (den_i - den_err), at least 0, or 1 (no
+  // bound) unless every den_i - den_err is positive. One pass without directed roundings
+  // (vectorised): a difference of doubles keeps its sign exactly, and each of the sum, the
+  // difference and the quotient rounds once (relative u each; an underflowing quotient
+  // loses at most denorm_min), so (1 + 4u) times the computed maximum, rounded up, plus
+  // denorm_min covers the exact one.
   double max_ratio(const double* num, double num_err, const double* den, double den_err) const {
-    double r = 0;
+    double least = kInf, r = 0;
+#pragma omp simd reduction(min : least) reduction(max : r)
     for (std::size_t i = 0; i < size_; ++i) {
-      const double den_lo = down(den[i] - den_err);
-      if (!(den_lo > 0)) return 1;
-      r = std::max(r, up(std::max(0.0, up(num[i] + num_err)) / den_lo));
+      const double d = den[i] - den_err;
+      least = std::min(least, d);
+      r = std::max(r, (num[i] + num_err) / d);
     }
-    return r;
+    if (!(least > 0)) return 1;
+    return up(up(r * (1 + 4 * kUnit)) + std::numeric_limits<double>::denorm_min());
   }
 
   const ScaledJacobianSpace& space_;
