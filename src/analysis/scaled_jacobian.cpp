@@ -82,21 +82,26 @@ class Bounder {
     bool positive = true;
     for (std::size_t i = 0; i < size_ && positive && !valid_; ++i) positive = down(j[i] - err[0]) > 0;
     if (positive) {
+      // r = min_k min_i (N_i - e) / (D_k,i + e_k): one pass per frame without directed
+      // roundings, as in max_ratio; only a positive r is used, and then every N_i - e > 0.
       double r = kInf;
       for (std::size_t k = 0; k < frames_; ++k) {
         const double* d = v + (2 + k) * size_;
         const double ed = err[2 + k];
+        double least_d = kInf, rk = kInf;
+#pragma omp simd reduction(min : least_d, rk)
         for (std::size_t i = 0; i < size_; ++i) {
-          const double d_lo = down(d[i] - ed);
-          if (!(d_lo > 0)) return 0;  // relaxation fails here; J > 0 gives sj > 0
-          const double n_lo = down(n[i] - err[1]);
-          r = std::min(r, n_lo >= 0 ? down(n_lo / up(d[i] + ed)) : down(n_lo / d_lo));
+          least_d = std::min(least_d, d[i] - ed);
+          rk = std::min(rk, (n[i] - err[1]) / (d[i] + ed));
         }
+        if (!(least_d > 0)) return 0;  // relaxation fails here; J > 0 gives sj > 0
+        r = std::min(r, rk);
       }
+      r = r > 0 ? down(down(r * (1 - 4 * kUnit)) - std::numeric_limits<double>::denorm_min()) : 0;
       return down(space_.s_lo() * down(std::sqrt(std::max(0.0, r))));
     }
     // J not proven positive: per frame, the best of the bounds below; sj is their minimum.
-    const double j_lo = down(*std::min_element(j, j + size_) - err[0]);
+    const double j_lo = down(least(j) - err[0]);
     double out = kInf;
     for (std::size_t k = 0; k < frames_; ++k) {
       const double* d = v + (2 + k) * size_;
@@ -122,7 +127,7 @@ class Bounder {
         if (j_lo >= 0) {
           best = 0;
         } else {
-          const double d_lo = down(*std::min_element(d, d + size_) - ed);
+          const double d_lo = down(least(d) - ed);
           if (d_lo > 0) best = std::max(best, -up(space_.s_hi() * up(-j_lo / down(std::sqrt(d_lo)))));
         }
       }
@@ -179,6 +184,14 @@ class Bounder {
   }
 
  private:
+  // The least of the size_ values at x (vectorised).
+  double least(const double* x) const {
+    double m = kInf;
+#pragma omp simd reduction(min : m)
+    for (std::size_t i = 0; i < size_; ++i) m = std::min(m, x[i]);
+    return m;
+  }
+
   // An upper bound of max_i (num_i + num_err) / (den_i - den_err), at least 0, or 1 (no
   // bound) unless every den_i - den_err is positive. One pass without directed roundings
   // (vectorised): a difference of doubles keeps its sign exactly, and each of the sum, the

@@ -97,28 +97,49 @@ BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
   std::sort(vertex_indices_.begin(), vertex_indices_.end());
 }
 
-void BernsteinBisection::bisect(const double* in, std::size_t f, int a, int b, double* keep_a,
+void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t f, int a, int b, double* keep_a,
                                 double* keep_b) const {
   const EdgeLines& el = lines(f, a, b);
   const int stride = stride_[f];
-  std::array<double, 128> w{};
-  for (int base : bases_[f])
-    for (std::size_t l = 0; l + 1 < el.first.size(); ++l) {
-      const int* idx = el.index.data() + el.first[l];
-      const int m = el.first[l + 1] - el.first[l] - 1;
-      QV_ASSERT(m < static_cast<int>(w.size()), "line of degree " << m);
-      for (int i = 0; i <= m; ++i) w[static_cast<std::size_t>(i)] = in[base + stride * idx[i]];
-      // Level r of the de Casteljau triangle: w[0] is the keep-a child's coefficient with
-      // r midpoints, w[m - r] the keep-b child's with m - r copies of b.
-      keep_a[base + stride * idx[0]] = w[0];
-      keep_b[base + stride * idx[m]] = w[static_cast<std::size_t>(m)];
-      for (int r = 1; r <= m; ++r) {
-        for (int j = 0; j + r <= m; ++j)
-          w[static_cast<std::size_t>(j)] = (w[static_cast<std::size_t>(j)] + w[static_cast<std::size_t>(j + 1)]) * 0.5;
-        keep_a[base + stride * idx[r]] = w[0];
-        keep_b[base + stride * idx[m - r]] = w[static_cast<std::size_t>(m - r)];
+  const auto size = static_cast<std::size_t>(size_);
+  // Up to kGroup vectors at once, lane v holding vector v: the same averages per
+  // coefficient as one vector alone (bit-identical), the index work shared and the
+  // averages vectorised across the vectors.
+  constexpr std::size_t kGroup = 16, kMaxLine = 128;
+  std::array<double, kMaxLine * kGroup> w;  // lanes v < n of rows 0..m are written before read
+  for (std::size_t g0 = 0; g0 < count; g0 += kGroup) {
+    const std::size_t n = std::min(kGroup, count - g0);
+    const double* src = in + g0 * size;
+    double* ka = keep_a + g0 * size;
+    double* kb = keep_b + g0 * size;
+    for (int base : bases_[f])
+      for (std::size_t l = 0; l + 1 < el.first.size(); ++l) {
+        const int* idx = el.index.data() + el.first[l];
+        const int m = el.first[l + 1] - el.first[l] - 1;
+        QV_ASSERT(m < static_cast<int>(kMaxLine), "line of degree " << m);
+        const auto at = [&](int i) { return static_cast<std::size_t>(base + stride * idx[i]); };
+        for (int i = 0; i <= m; ++i)
+          for (std::size_t v = 0; v < n; ++v) w[static_cast<std::size_t>(i) * kGroup + v] = src[v * size + at(i)];
+        // Level r of the de Casteljau triangle: w[0] is the keep-a child's coefficient with
+        // r midpoints, w[m - r] the keep-b child's with m - r copies of b.
+        for (std::size_t v = 0; v < n; ++v) {
+          ka[v * size + at(0)] = w[v];
+          kb[v * size + at(m)] = w[static_cast<std::size_t>(m) * kGroup + v];
+        }
+        for (int r = 1; r <= m; ++r) {
+          for (int j = 0; j + r <= m; ++j) {
+            double* lo = w.data() + static_cast<std::size_t>(j) * kGroup;
+            const double* hi = lo + kGroup;
+#pragma omp simd
+            for (std::size_t v = 0; v < n; ++v) lo[v] = (lo[v] + hi[v]) * 0.5;
+          }
+          for (std::size_t v = 0; v < n; ++v) {
+            ka[v * size + at(r)] = w[v];
+            kb[v * size + at(m - r)] = w[static_cast<std::size_t>(m - r) * kGroup + v];
+          }
+        }
       }
-    }
+  }
 }
 
 void BernsteinBisection::split(const double* parent, std::size_t count, const BisectionState& state,
@@ -144,10 +165,7 @@ void BernsteinBisection::split(const double* parent, std::size_t count, const Bi
         const auto& o = s.order[f];
         const int k = s.tag[f];
         const int a = o[0], b = o[static_cast<std::size_t>(k)];
-        for (std::size_t v = 0; v < count; ++v)
-          bisect(cur + p * block + v * static_cast<std::size_t>(size_), f, a, b,
-                 nxt + (2 * p) * block + v * static_cast<std::size_t>(size_),
-                 nxt + (2 * p + 1) * block + v * static_cast<std::size_t>(size_));
+        bisect(cur + p * block, count, f, a, b, nxt + (2 * p) * block, nxt + (2 * p + 1) * block);
         const auto tag = static_cast<std::int8_t>(k > 1 ? k - 1 : factors_[f].dim);
         BisectionState first = s, second = s;
         first.tag[f] = tag;   // (x_0..x_{k-1}, z, x_{k+1}..): z took x_k's slot b

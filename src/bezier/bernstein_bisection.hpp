@@ -92,9 +92,10 @@ class BernsteinBisection {
     std::vector<int> first;  // #lines + 1 offsets into index
     std::vector<int> index;
   };
-  // Bisects vector `in` (size_) along factor f's edge between slots a and b: out_keep_a has
-  // slot b replaced by the midpoint, out_keep_b slot a.
-  void bisect(const double* in, std::size_t f, int a, int b, double* out_keep_a,
+  // Bisects the `count` vectors at `in` (size_ each, contiguous) along factor f's edge
+  // between slots a and b: out_keep_a has slot b replaced by the midpoint, out_keep_b slot
+  // a (same layout).
+  void bisect(const double* in, std::size_t count, std::size_t f, int a, int b, double* out_keep_a,
               double* out_keep_b) const;
   const EdgeLines& lines(std::size_t f, int a, int b) const {
     return lines_[f][static_cast<std::size_t>(a * 4 + b)];
