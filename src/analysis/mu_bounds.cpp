@@ -36,6 +36,7 @@ struct MuScratch {
   std::vector<double> pool;
   std::vector<int> free_slots;
   std::vector<double> sub_scratch;
+  std::vector<std::array<double, 9>> corners;  // W at the corners bounded in this split
 };
 
 // W's control values of the whole element (layout of MuMetric::lower_bound) and their
@@ -220,6 +221,9 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       wmax = std::max(wmax, std::abs(pool[static_cast<std::size_t>(top.slot) * block + i]));
     // S_q exact, nonnegative, rows summing to 1: the parent's error carries over as is.
     const double child_err = (top.err + sub_rounding * wmax) * (1 + 1e-12);
+    // The parent's corners are in r_upper already, bounded with a smaller error bound.
+    scratch.corners.clear();
+    remember_corners(space, pool.data() + static_cast<std::size_t>(top.slot) * block, scratch.corners);
     for (int q = 0; q < basis.num_children(); ++q) {
       int slot;
       if (!free_slots.empty()) {
@@ -234,7 +238,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       // All vectors at once: the child's matrix is read once (bit-identical to one by one).
       basis.subdivide_many(q, pool.data() + par, static_cast<std::size_t>(vectors),
                            pool.data() + child, scratch.sub_scratch.data());
-      const double corner = corner_ratio_upper(space, pool.data() + child, child_err);
+      const double corner = corner_ratio_upper(space, pool.data() + child, child_err, &scratch.corners);
       r_upper = std::min(r_upper, corner);
       const double lo = subdomain_lower(pool.data() + child, child_err, top.lower, std::min(corner, r_upper));
       heap.push({lo, child_err, slot});

@@ -465,7 +465,26 @@ double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err) {
 
 }  // namespace
 
-double corner_ratio_upper(const MuSpace& space, const double* w, double err) {
+namespace {
+
+// W at corner k of the subdomain (entries j * 3 + c; zero beyond dim).
+std::array<double, 9> corner_w(const MuSpace& space, const double* w, int k) {
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  std::array<double, 9> out{};
+  for (int j = 0; j < space.dim(); ++j)
+    for (int c = 0; c < 3; ++c)
+      out[static_cast<std::size_t>(j * 3 + c)] = w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + static_cast<std::size_t>(k)];
+  return out;
+}
+
+}  // namespace
+
+void remember_corners(const MuSpace& space, const double* w, std::vector<std::array<double, 9>>& seen) {
+  for (const int k : space.w_basis().vertex_indices()) seen.push_back(corner_w(space, w, k));
+}
+
+double corner_ratio_upper(const MuSpace& space, const double* w, double err,
+                          std::vector<std::array<double, 9>>* seen) {
   const int dim = space.dim();
   const auto ws = static_cast<std::size_t>(space.w_size());
   const auto at = [&](int j, int c, int k) {
@@ -473,6 +492,11 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err) {
   };
   double best = 1;
   for (const int k : space.w_basis().vertex_indices()) {
+    if (seen) {
+      const std::array<double, 9> key = corner_w(space, w, k);
+      if (std::find(seen->begin(), seen->end(), key) != seen->end()) continue;
+      seen->push_back(key);
+    }
     if (dim == 2) {
       Eigen::Matrix<double, 3, 2> wm;
       for (int j = 0; j < 2; ++j)

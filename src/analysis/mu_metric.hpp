@@ -33,6 +33,7 @@
 // Rounding: every control value carries a uniform absolute error bound (W from mu_space,
 // Bernstein products from bernstein_product.hpp, sums with gamma_k), and a test "c >= 0"
 // passes only when the computed value exceeds its error bound.
+#include <array>
 #include <vector>
 
 #include "analysis/mu_space.hpp"
@@ -91,6 +92,15 @@ class MuMetric {
 /// are values of W): the Rayleigh quotients of W at approximate eigenvectors of W^T W,
 /// evaluated in interval fashion, bound lambda_min from above and lambda_max from below.
 /// Returns min over the corners (<= 1).
-double corner_ratio_upper(const MuSpace& space, const double* w, double err);
+/// @param seen  optional: the W values (dim x 3, as laid out per corner) of corners already
+///              bounded with an error bound at most `err`; a corner whose W equals one of
+///              them bit for bit is skipped (its bound could only be the same or looser),
+///              and every corner evaluated is appended. Subdivision children share most
+///              corners with their parent and their siblings (a hexahedron's 8 children:
+///              64 corners, 27 points, 8 of them the parent's).
+double corner_ratio_upper(const MuSpace& space, const double* w, double err,
+                          std::vector<std::array<double, 9>>* seen = nullptr);
+/// Appends the W values of the subdomain's corners to `seen` (corner_ratio_upper's layout).
+void remember_corners(const MuSpace& space, const double* w, std::vector<std::array<double, 9>>& seen);
 
 }  // namespace quadval
