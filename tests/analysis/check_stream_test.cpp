@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 #include <string>
@@ -23,6 +24,7 @@
 
 #include "jacobian_test_util.hpp"
 #include "quadval/check_report.hpp"
+#include "quadval/error.hpp"
 #include "quadval/io.hpp"
 
 namespace quadval {
@@ -304,6 +306,47 @@ TEST(CheckStream, CliFilesEqualTheLibrarys) {
   EXPECT_EQ(got, want);
   EXPECT_GT(std::filesystem::file_size(dir / "a.vtu"), 0u);
   std::filesystem::remove_all(dir);
+}
+
+// The coordinate checks of one pass (finite, span per axis) and the planar test: a
+// non-finite coordinate or a span beyond 1e40 is refused naming the file, wherever it
+// sits; a triangle mesh is planar when its triangles' nodes share z, even when a node no
+// triangle uses lies elsewhere.
+TEST(CheckStream, CoordinateChecksAndPlanarTest) {
+  Mesh mesh;
+  mesh.node_tags = {1, 2, 3, 4, 5};
+  mesh.coords = {0, 0, 2, 1, 0, 2, 0, 1, 2, 1, 1, 2, 5, 5, 7};  // node 5 off the plane
+  ElementBlock tris;
+  tris.type = find_element_type(2);  // 3-node triangle
+  tris.tags = {1, 2};
+  tris.nodes = {0, 1, 2, 1, 3, 2};
+  mesh.blocks.push_back(tris);
+  CheckOptions o;
+  EXPECT_TRUE(check_mesh(mesh, o, "m.msh").planar);
+  Mesh lifted = mesh;
+  lifted.coords[11] = 2.5;  // node 4's z: the triangles no longer share z
+  EXPECT_FALSE(check_mesh(lifted, o, "m.msh").planar);
+  Mesh flat = mesh;
+  flat.coords[14] = 2;  // every node on the plane: the one-pass answer
+  EXPECT_TRUE(check_mesh(flat, o, "m.msh").planar);
+  for (std::size_t at : {std::size_t{0}, std::size_t{7}, std::size_t{14}})
+    for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity(),
+                       -std::numeric_limits<double>::infinity()}) {
+      Mesh m = mesh;
+      m.coords[at] = bad;
+      try {
+        check_mesh(m, o, "bad.msh");
+        ADD_FAILURE() << "accepted " << bad << " at " << at;
+      } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("bad.msh"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("not finite"), std::string::npos) << e.what();
+      }
+    }
+  Mesh wide = mesh;
+  wide.coords[13] = 2e40;  // node 5's y: a span of 2e40
+  EXPECT_THROW(check_mesh(wide, o, "wide.msh"), InputError);
+  wide.coords[13] = 5e39;
+  EXPECT_NO_THROW(check_mesh(wide, o, "wide.msh"));
 }
 
 }  // namespace
