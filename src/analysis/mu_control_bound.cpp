@@ -127,6 +127,30 @@ bool positive_definite3(const double* a) {
   return det > g * mag * (1 + g);
 }
 
+// True when lambda_min >= r lambda_max is certified for every exact symmetric M' with
+// |M'_ij - m_ij| <= err: no eigenvalue needed. By Laguerre and Samuelson, every
+// eigenvalue of m lies within sqrt 2 sigma of their mean mu = tr m / 3, sigma^2 =
+// tr((m - mu I)^2) / 3 <= tr((m - c I)^2) / 3 for any c (here the computed mean), so
+// t = c + |mu - c| + sqrt(2/3 tr((m - c I)^2)) + 3 err >= lambda_max(M') (|E|_2 <= 3 err),
+// every step rounded up; then M' - r t I > 0 (Sylvester, as in extreme_eigen_bounds3)
+// gives lambda_min(M') > r t >= r lambda_max(M'). Cheap (one square root) and tight for the
+// nearly isotropic control matrices of a good element; it fails, and the caller encloses
+// the eigenvalues, when eigenvalues cluster at the top.
+bool ratio_at_least3(const double* m, double err, double r) {
+  constexpr double u = 0x1p-53;
+  const double c = (m[0] + m[1] + m[2]) / 3;
+  const double shift = 4 * u * (std::abs(m[0]) + std::abs(m[1]) + std::abs(m[2]));  // >= |mu - c|
+  const double d0 = m[0] - c, d1 = m[1] - c, d2 = m[2] - c;
+  const double sq = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (m[3] * m[3] + m[4] * m[4] + m[5] * m[5]);
+  if (!std::isfinite(sq)) return false;
+  // sq within 8u relative of tr((m - c I)^2) (sums of squares of once-rounded terms).
+  const double spread = next_up(std::sqrt(next_up(sq * (2.0 / 3.0) * (1 + 16 * u))));
+  const double t = next_up(next_up(next_up(c + shift) + spread) + next_up(3 * err * (1 + 1e-15)));
+  const double sa = next_up(next_up(r * t) + next_up(3 * err * (1 + 1e-15)));
+  const double s[6] = {next_down(m[0] - sa), next_down(m[1] - sa), next_down(m[2] - sa), m[3], m[4], m[5]};
+  return positive_definite3(s);
+}
+
 }  // namespace
 
 bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi) {
@@ -182,6 +206,9 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
   for (int k = 0; k < size && r > 0; ++k) {
     for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
     if constexpr (D == 3) {
+      // Most control matrices lie well above the least ratio found so far: certify that
+      // cheaply and skip their eigenvalue enclosure (the minimum, hence r, is unchanged).
+      if (r < 1 && ratio_at_least3(m, e, r)) continue;
       double lo, hi;
       if (extreme_eigen_bounds3(m, e, lo, hi)) {
         r = std::min(r, lo > 0 ? std::clamp(next_down(lo / hi), 0.0, 1.0) : 0.0);

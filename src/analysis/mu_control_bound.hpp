@@ -61,7 +61,10 @@ EigenEnclosure symmetric_eigen_enclosure(const double* m, double err);
 ///         to rounding): use symmetric_eigen_enclosure then.
 bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi);
 
-/// Certified lower bound of min R over a subdomain (the concavity argument above).
+/// Certified lower bound of min R over a subdomain (the concavity argument above): the
+/// least certified ratio over the control matrices. A matrix whose ratio is certified to
+/// be at least the least one so far without eigenvalues (Laguerre-Samuelson bound of
+/// lambda_max, then Sylvester's criterion on M - r lambda_max I) skips its enclosure.
 /// @param entries  D (D + 1) / 2 coefficient vectors of `size` control values each, in the
 ///                 order of symmetric_eigen_enclosure (m00, m11, (m22,) m01, ...)
 /// @param err      per entry vector, |exact control value - computed| <= err[i]

@@ -17,6 +17,7 @@
 // since the exact convex weights of one k sum to 1 — the same bound as the entry kernel.
 #include "bezier/bernstein_product.hpp"
 
+#include <array>
 #include <gmpxx.h>
 
 #include <map>
@@ -247,8 +248,37 @@ void BernsteinProduct::accumulate_grid(const double* f, const double* g, double 
   }
 }
 
+// The entry kernel for N terms in one walk over the pairs: per pair, the N scaled products
+// summed (N + 1 roundings deep), times the pair's weight, then the row's sum. Within
+// rounding(N): with the weight's own rounding, N + 3 per pair plus the row's max_terms
+// and the addition into h, at most N * max_terms + 16; and the weights of a row sum to 1,
+// so the magnitude is at most sum_t |scale_t| max|f_t| max|g_t|, as for N separate walks.
+template <std::size_t N>
+void BernsteinProduct::fused_entries(std::span<const Term> terms, double* h) const {
+  std::array<double, N> sc;
+  std::array<const double*, N> f, g;
+  for (std::size_t t = 0; t < N; ++t) {
+    sc[t] = terms[t].scale;
+    f[t] = terms[t].f;
+    g[t] = terms[t].g;
+  }
+  const Pair* pairs = pairs_.data();
+  for (int k = 0; k < h_size_; ++k) {
+    double acc = 0;
+    for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
+      const int i = pairs[p].i, j = pairs[p].j;
+      double sum = 0;
+      for (std::size_t t = 0; t < N; ++t) sum += sc[t] * (f[t][i] * g[t][j]);
+      acc += pairs[p].w * sum;
+    }
+    h[k] += acc;
+  }
+}
+
 void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) const {
   if (entries_kernel_) {
+    if (!pairs_.empty() && terms.size() == 2) return fused_entries<2>(terms, h);
+    if (!pairs_.empty() && terms.size() == 3) return fused_entries<3>(terms, h);
     for (const Term& t : terms) multiply_add(t.f, t.g, t.scale, h);
     return;
   }

@@ -53,8 +53,8 @@ class BernsteinProduct {
     const double* g;
   };
   /// h += sum_t scale_t f_t g_t. The scaled convolution keeps the whole sum in scaled form
-  /// and unscales once; rounding(terms.size()) bounds the result as for repeated
-  /// multiply_add.
+  /// and unscales once, the entry kernel sums 2 or 3 terms per pair in one walk;
+  /// rounding(terms.size()) bounds the result as for repeated multiply_add.
   void multiply_add_sum(std::span<const Term> terms, double* h) const;
   /// Choose the per-factor weighted-entry loop (default for small products) or the scaled
   /// convolution (default for large ones); same product within rounding().
@@ -83,6 +83,8 @@ class BernsteinProduct {
   };
   std::vector<int> row_start_;
   std::vector<Pair> pairs_;
+  template <std::size_t N>
+  void fused_entries(std::span<const Term> terms, double* h) const;
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
   // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k. Every

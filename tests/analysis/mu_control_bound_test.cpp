@@ -177,6 +177,76 @@ TEST(MuControlBound, ControlRatioIsMinimumOverControlMatrices) {
   EXPECT_NEAR(r, 1.0 / 9, 1e-11);  // the certification margins are 1e-12 relative
 }
 
+// lambda_min(M) >= r lambda_max(M) for a symmetric 3 x 3 M, exactly: the eigenvalues of
+// M (x) I - r I (x) M are lambda_i - r lambda_j, so the 9 x 9 Kronecker matrix is
+// positive definite (rational LDL^T, every pivot > 0) exactly when every lambda_i > r
+// lambda_j.
+bool ratio_above_exactly(const Exact& m, const mpq_class& r) {
+  std::array<std::array<mpq_class, 9>, 9> k;
+  for (int a = 0; a < 9; ++a)
+    for (int b = 0; b < 9; ++b) {
+      const int i = a / 3, j = a % 3, p = b / 3, q = b % 3;
+      k[a][b] = (j == q ? m[i][p] : mpq_class(0)) - (i == p ? r * m[j][q] : mpq_class(0));
+    }
+  for (int c = 0; c < 9; ++c) {
+    if (!(k[c][c] > 0)) return false;
+    for (int a = c + 1; a < 9; ++a) {
+      const mpq_class f = k[a][c] / k[c][c];
+      for (int b = c; b < 9; ++b) k[a][b] -= f * k[c][b];
+    }
+  }
+  return true;
+}
+
+TEST(MuControlBound, ControlRatioAgainstExactKroneckerCriterion) {
+  // Sets of 27 control matrices Q diag(l) Q^T, each set around a common shape: the least
+  // ratio of the set (computed here by Eigen, for tightness only) must be certified, and
+  // every matrix of the set must satisfy lambda_min > r lambda_max exactly, also at the
+  // corners of the error box. Shapes: nearly isotropic, one large and two equal
+  // eigenvalues (where the eigenvalue-free test is sharp), two equal large ones (where it
+  // is loose and the enclosure must take over), and spread ones.
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const std::array<std::array<double, 3>, 4> shapes = {{{1, 0.97, 0.95}, {1, 0.6, 0.6}, {1, 1, 0.5}, {1, 0.5, 0.2}}};
+  int sets = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const auto& shape = shapes[static_cast<std::size_t>(trial % 4)];
+    const double err = trial % 3 == 0 ? 1e-9 : 0.0;
+    std::vector<std::array<double, 6>> ms(27);
+    double least = 1;
+    for (auto& m : ms) {
+      const Eigen::Matrix3d q = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+      Eigen::Vector3d l;
+      for (int i = 0; i < 3; ++i) l[i] = shape[static_cast<std::size_t>(i)] * (1 + 0.05 * u(rng));
+      const Eigen::Matrix3d a = q * l.asDiagonal() * q.transpose();
+      m = {a(0, 0), a(1, 1), a(2, 2), a(0, 1), a(0, 2), a(1, 2)};
+      least = std::min(least, l.minCoeff() / l.maxCoeff());
+    }
+    std::array<std::vector<double>, 6> entries;
+    for (int i = 0; i < 6; ++i)
+      for (const auto& m : ms) entries[static_cast<std::size_t>(i)].push_back(m[static_cast<std::size_t>(i)]);
+    const double* e[6];
+    for (int i = 0; i < 6; ++i) e[i] = entries[static_cast<std::size_t>(i)].data();
+    const double errs[6] = {err, err, err, err, err, err};
+    const double r = control_ratio_lower<3>(e, errs, 27);
+    SCOPED_TRACE(trial);
+    EXPECT_GT(r, least * (1 - 1e-6));  // tight (the rotation's rounding moves l by ~1e-16)
+    for (const auto& m : ms)
+      for (int corner = 0; corner < (err > 0 ? 4 : 1); ++corner) {
+        // The matrix itself, or a corner of its error box.
+        std::array<double, 6> d{};
+        for (int i = 0; i < 6; ++i) d[static_cast<std::size_t>(i)] = corner == 0 ? 0 : ((i + corner) % 2 ? err : -err);
+        Exact x;
+        const auto pos = entry_positions<3>();
+        for (std::size_t i = 0; i < 6; ++i)
+          x[pos[i][0]][pos[i][1]] = x[pos[i][1]][pos[i][0]] = mpq_class(m[i]) + mpq_class(d[i]);
+        ASSERT_TRUE(ratio_above_exactly(x, mpq_class(r))) << "r " << r;
+      }
+    ++sets;
+  }
+  EXPECT_EQ(sets, 60);
+}
+
 // mu_bounds with the given subdomain bound against dense sampling of W's singular values.
 void check_against_sampling(int mode, double tol, unsigned seed) {
   mu_use_control_bound(mode);
