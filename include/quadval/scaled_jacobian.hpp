@@ -73,9 +73,9 @@
 /// scaled_jacobian_quotient.hpp).
 /// upper is the minimum of sj at points (the corners of the subdomains, where a Bézier
 /// coefficient is a value), rounded up by their error bounds. Refinement is best-first
-/// (the subdomain with the smallest lower bound is split into 2^dim children by edge
-/// bisection, bezier/bernstein_bisection.hpp) until upper - lower <= abs_tol or
-/// max_subdivisions subdomains were split.
+/// (the subdomain with the smallest lower bound is halved by one edge bisection,
+/// bezier/bernstein_bisection.hpp; dim bisections count as one subdivision) until upper -
+/// lower <= abs_tol or max_subdivisions subdivisions were made.
 ///
 /// Folds. Where a frame column v_ka vanishes at a point p of a fold (J changes sign
 /// there), D_k(p) = 0 and sj has no limit at p: the N / D_k bound stays at -s however small

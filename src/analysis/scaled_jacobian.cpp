@@ -578,8 +578,15 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   };
   push(0);
 
+  // Refinement by single bisections (BernsteinBisection::halve): `levels` of them make one
+  // subdivision of the count reported and capped by max_subdivisions. Against all 2^dim
+  // children per step, at --tol 1e-2 on one thread (medians of 5): warped_tetrahedron_o3
+  // 0.83 -> 0.45 s, warped_prism 0.16 -> 0.08 s, warped_hexahedron 0.15 -> 0.10 s, mixed
+  // 0.36 -> 0.28 s; the straight-sided and barely curved meshes within noise.
   QualityBounds out;
-  const auto nc = static_cast<std::size_t>(b2.num_children());
+  const auto levels = static_cast<long>(b2.levels());
+  long halvings = 0;
+  constexpr std::size_t nc = 2;
   ws.children.resize(nc * stride);
   ws.child_states.resize(nc);
   ws.child_err.resize(nvec);
@@ -588,7 +595,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   while (!ws.heap.empty()) {
     const Leaf top = ws.heap.front();
     if (up(upper - std::min(top.lower, settled)) <= tol) break;
-    if (out.subdivisions >= options.max_subdivisions) break;
+    if (halvings >= static_cast<long>(options.max_subdivisions) * levels) break;
     const std::size_t parent_off = static_cast<std::size_t>(top.slot) * stride;
     // A fold around a vanishing frame column: the lower bound is at the floor and can
     // never rise (stuck_at_floor), so more subdivisions could only lower `upper`, which
@@ -600,7 +607,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
       break;
     std::pop_heap(ws.heap.begin(), ws.heap.end(), cmp);
     ws.heap.pop_back();
-    ++out.subdivisions;
+    ++halvings;
     ws.free_slots.push_back(top.slot);
     ws.parent_err.assign(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
                          ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
@@ -610,10 +617,10 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
                      ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
     const BisectionState parent_state = ws.states[static_cast<std::size_t>(top.slot)];
     for (std::size_t v = 0; v < nvec; ++v)
-      child_err[v] = up((parent_err[v] + b2.rounding_relative() * max_abs(ws.parent.data() + v * s2, s2) +
-                         b2.rounding_absolute()) * (1 + 1e-12));
-    // All nvec vectors of all children at once (bit-identical to one at a time).
-    b2.split(ws.parent.data(), nvec, parent_state, ws.children.data(), ws.child_states.data(), ws.work);
+      child_err[v] = up((parent_err[v] + b2.halving_rounding_relative() * max_abs(ws.parent.data() + v * s2, s2) +
+                         b2.halving_rounding_absolute()) * (1 + 1e-12));
+    // All nvec vectors of both children at once (bit-identical to one at a time).
+    b2.halve(ws.parent.data(), nvec, parent_state, ws.children.data(), ws.child_states.data());
     for (std::size_t q = 0; q < nc; ++q) {
       int slot;
       if (!ws.free_slots.empty()) {
@@ -633,6 +640,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
       push(slot);
     }
   }
+  out.subdivisions = static_cast<int>((halvings + levels - 1) / levels);
   double lower = settled;
   for (const Leaf& l : ws.heap) lower = std::min(lower, l.lower);
   out.lower = std::max(lower, quick.lower);

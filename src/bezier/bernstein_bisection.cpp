@@ -71,11 +71,15 @@ BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
     // d bisections of degree n per split.
     rounding_relative_ += d * n * kUnit;
     rounding_absolute_ += d * n * kHalfDenormMin;
+    halving_relative_ = std::max(halving_relative_, n * kUnit);
+    halving_absolute_ = std::max(halving_absolute_, n * kHalfDenormMin);
   }
   // The bound above counts one rounding per average; multiplying by 1 + 1e-12 covers
   // the rounding of this bound's own products.
   rounding_relative_ *= 1 + 1e-12;
   rounding_absolute_ *= 1 + 1e-12;
+  halving_relative_ *= 1 + 1e-12;
+  halving_absolute_ *= 1 + 1e-12;
 
   // Vertex coefficients: alpha = n e_a in every factor.
   std::array<std::vector<int>, 3> vertex_local;
@@ -180,7 +184,35 @@ void BernsteinBisection::split(const double* parent, std::size_t count, const Bi
     }
   }
   QV_ASSERT(cur == children && pieces == nc, "bisection levels");
-  for (std::size_t q = 0; q < nc; ++q) states[q].depth = state.depth + 1;
+  for (std::size_t q = 0; q < nc; ++q) {
+    states[q].depth = state.depth + 1;
+    states[q].step = state.step + dim_;
+  }
+}
+
+void BernsteinBisection::halve(const double* parent, std::size_t count, const BisectionState& state,
+                               double* children, BisectionState* states) const {
+  // The factor split() would bisect at this point of its sequence.
+  int level = state.step % dim_;
+  std::size_t f = 0;
+  while (level >= factors_[f].dim) level -= factors_[f].dim, ++f;
+  const auto& o = state.order[f];
+  const int k = state.tag[f];
+  const int a = o[0], b = o[static_cast<std::size_t>(k)];
+  const std::size_t block = static_cast<std::size_t>(size_) * count;
+  bisect(parent, count, f, a, b, children, children + block);
+  const auto tag = static_cast<std::int8_t>(k > 1 ? k - 1 : factors_[f].dim);
+  BisectionState first = state, second = state;
+  first.tag[f] = tag;
+  second.tag[f] = tag;
+  for (int i = 0; i < k; ++i) second.order[f][static_cast<std::size_t>(i)] = o[static_cast<std::size_t>(i + 1)];
+  second.order[f][static_cast<std::size_t>(k)] = static_cast<std::int8_t>(a);
+  for (BisectionState* st : {&first, &second}) {
+    st->step = state.step + 1;
+    st->depth = st->step / dim_;
+  }
+  states[0] = first;
+  states[1] = second;
 }
 
 }  // namespace quadval

@@ -52,6 +52,8 @@ struct BisectionState {
   std::array<std::int8_t, 3> tag{};
   /// Number of split() calls from the root.
   int depth = 0;
+  /// Number of single bisections from the root (a split counts levels() of them).
+  int step = 0;
 };
 
 class BernsteinBisection {
@@ -82,6 +84,21 @@ class BernsteinBisection {
   void split(const double* parent, std::size_t count, const BisectionState& state,
              double* children, BisectionState* states, std::vector<double>& scratch) const;
 
+  /// Bisections per split(): the sum of the factors' dimensions.
+  int levels() const noexcept { return dim_; }
+  /// One bisection, the next one split() would do in its sequence (factors in turn, each
+  /// dim times; Maubach's order within a factor): 2 children of half the measure each.
+  /// A best-first refinement that halves only the subdomain it needs splits the measure
+  /// near a minimum as finely with fewer bisections and bounds than split(), which
+  /// makes all 2^dim children of every subdomain it refines.
+  /// @param children out: 2 blocks of count x size() (child-major)
+  /// @param states   out: 2 states (step = state.step + 1)
+  void halve(const double* parent, std::size_t count, const BisectionState& state, double* children,
+             BisectionState* states) const;
+  /// The rounding bounds of halve(), as below for split().
+  double halving_rounding_relative() const noexcept { return halving_relative_; }
+  double halving_rounding_absolute() const noexcept { return halving_absolute_; }
+
   /// |computed child coefficient - exact one (of the computed parent)| <=
   /// rounding_relative() * max|parent| + rounding_absolute(), for every coefficient.
   double rounding_relative() const noexcept { return rounding_relative_; }
@@ -110,6 +127,7 @@ class BernsteinBisection {
   std::vector<int> vertex_indices_;
   BisectionState root_;
   double rounding_relative_ = 0, rounding_absolute_ = 0;
+  double halving_relative_ = 0, halving_absolute_ = 0;  // the largest factor's one bisection
 };
 
 }  // namespace quadval

@@ -234,6 +234,64 @@ TEST_P(BisectionTest, ChildrenReproduceTheParentAndHalveTheMeasure) {
   EXPECT_NEAR(total, 1.0, 1e-13);
 }
 
+TEST_P(BisectionTest, HalvingLevelsTimesIsOneSplit) {
+  // levels() single bisections in breadth-first order give split()'s children, bit for
+  // bit, with the same states; a second round continues the sequence.
+  const BernsteinBisection space(GetParam());
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto size = static_cast<std::size_t>(space.size());
+  std::vector<double> parent(2 * size);
+  for (double& v : parent) v = u(rng);
+  std::vector<std::vector<double>> coeffs{parent};
+  std::vector<BisectionState> states{space.root_state()};
+  std::vector<double> scratch;
+  for (int round = 0; round < 2; ++round) {
+    // The reference: split() of every piece of the previous round.
+    std::vector<std::vector<double>> want;
+    std::vector<BisectionState> want_states;
+    const auto nc = static_cast<std::size_t>(space.num_children());
+    for (std::size_t p = 0; p < coeffs.size(); ++p) {
+      std::vector<double> out(nc * 2 * size);
+      std::vector<BisectionState> st(nc);
+      space.split(coeffs[p].data(), 2, states[p], out.data(), st.data(), scratch);
+      for (std::size_t q = 0; q < nc; ++q) {
+        want.emplace_back(out.begin() + static_cast<std::ptrdiff_t>(q * 2 * size),
+                          out.begin() + static_cast<std::ptrdiff_t>((q + 1) * 2 * size));
+        want_states.push_back(st[q]);
+      }
+    }
+    for (int level = 0; level < space.levels(); ++level) {
+      std::vector<std::vector<double>> next;
+      std::vector<BisectionState> next_states;
+      for (std::size_t p = 0; p < coeffs.size(); ++p) {
+        std::vector<double> out(4 * size);
+        BisectionState st[2];
+        space.halve(coeffs[p].data(), 2, states[p], out.data(), st);
+        for (std::size_t q = 0; q < 2; ++q) {
+          next.emplace_back(out.begin() + static_cast<std::ptrdiff_t>(q * 2 * size),
+                            out.begin() + static_cast<std::ptrdiff_t>((q + 1) * 2 * size));
+          next_states.push_back(st[q]);
+        }
+      }
+      coeffs = std::move(next);
+      states = std::move(next_states);
+    }
+    ASSERT_EQ(coeffs.size(), want.size());
+    for (std::size_t p = 0; p < coeffs.size(); ++p) {
+      EXPECT_EQ(coeffs[p], want[p]) << "round " << round << " piece " << p;
+      EXPECT_EQ(states[p].order, want_states[p].order);
+      EXPECT_EQ(states[p].tag, want_states[p].tag);
+      EXPECT_EQ(states[p].depth, round + 1);
+      EXPECT_EQ(states[p].step, (round + 1) * space.levels());
+    }
+  }
+  int largest = 0;
+  for (const FactorDegree& fd : space.factors()) largest = std::max(largest, fd.degree);
+  EXPECT_GE(space.halving_rounding_relative(), largest * 0x1p-53);
+  EXPECT_LT(space.halving_rounding_relative(), largest * 0x1p-53 * 1.01 + 1e-300);
+}
+
 INSTANTIATE_TEST_SUITE_P(Spaces, BisectionTest,
                          testing::Values(std::vector<FactorDegree>{{1, 7}}, std::vector<FactorDegree>{{2, 6}},
                                          std::vector<FactorDegree>{{3, 5}}, std::vector<FactorDegree>{{1, 3}, {1, 4}},
