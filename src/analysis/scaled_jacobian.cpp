@@ -55,7 +55,7 @@ struct Leaf {
 };
 
 struct Scratch {
-  std::vector<double> values, work, parent, parent_err, children, child_err;
+  std::vector<double> values, parent, parent_err, children, child_err;
   std::vector<double> pool, pool_err;
   std::vector<BisectionState> states, child_states;  // states[slot]: the leaf's bisection state
   std::vector<int> free_slots;
@@ -312,7 +312,7 @@ void frame_column(const Frame& fr, std::size_t j, std::size_t dim, const Columns
 // The polynomials of one element, reused from element to element.
 struct Polys {
   Columns col;
-  std::array<Poly, 3> w, v;
+  std::array<Poly, 3> w;  // a cross product of two columns
   Poly jac, n, jsq, one, prod, tmp;
   std::array<std::array<Poly, 3>, 3> frame_col;  // one frame's columns [j][coordinate]
   std::array<Poly, 3> frame_sq;                  // their squared norms
