@@ -590,7 +590,10 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
   const auto S = static_cast<std::size_t>(basis_->size());
   constexpr std::size_t w = W;
 
-  // Coordinates relative to each element's first node, and their ranges R_j.
+  // Coordinates relative to each element's first node, and their ranges R_j. A planar 2D
+  // J = x_xi y_eta - x_eta y_xi takes no z: neither its derivatives nor, below, its error
+  // bound (the reference direction n = +z weighs only the x, y terms).
+  const std::size_t axes = dim_ == 2 && planar ? 2 : 3;
   double* x = buf;
   double* range = x + n * 3 * w;
   for (std::size_t j = 0; j < 3; ++j)
@@ -598,7 +601,7 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
   for (std::size_t l = 0; l < w; ++l) {
     const double* xe = nodes + l * stride;
     for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = 0; j < 3; ++j) {
+      for (std::size_t j = 0; j < axes; ++j) {
         const double d = xe[3 * i + j] - xe[j];
         x[(i * 3 + j) * w + l] = d;
         range[j * w + l] = std::max(range[j * w + l], std::abs(d));
@@ -616,22 +619,30 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
     const auto rows = static_cast<std::size_t>(deriv_space_[cs].total);
     double* d = deriv[cs] = next;
     next += rows * 3 * w;
-    for (std::size_t k = 0; k < rows; ++k) {
-      const double inv = deriv_inv_mult_[cs][k];
-      for (std::size_t j = 0; j < 3; ++j) {
-        double acc[W] = {};
+    // All axes in one walk over the row's nonzeros (each axis's sum in the same order).
+    const auto derive = [&]<std::size_t kAxes>() {
+      for (std::size_t k = 0; k < rows; ++k) {
+        const double inv = deriv_inv_mult_[cs][k];
+        double acc[kAxes][W] = {};
         for (int t = r.first[k]; t < r.first[k + 1]; ++t) {
           const double g = r.weight[static_cast<std::size_t>(t)];
-          const double* xi = x + (static_cast<std::size_t>(r.node[static_cast<std::size_t>(t)]) * 3 + j) * w;
-          #pragma omp simd
-          for (std::size_t l = 0; l < w; ++l) acc[l] += g * xi[l];
+          const double* xi = x + static_cast<std::size_t>(r.node[static_cast<std::size_t>(t)]) * 3 * w;
+          for (std::size_t j = 0; j < kAxes; ++j) {
+            #pragma omp simd
+            for (std::size_t l = 0; l < w; ++l) acc[j][l] += g * xi[j * w + l];
+          }
         }
-        for (std::size_t l = 0; l < w; ++l) {
-          d[(k * 3 + j) * w + l] = acc[l];
-          big[c][j][l] = std::max(big[c][j][l], std::abs(acc[l]) * inv);
-        }
+        for (std::size_t j = 0; j < kAxes; ++j)
+          for (std::size_t l = 0; l < w; ++l) {
+            d[(k * 3 + j) * w + l] = acc[j][l];
+            big[c][j][l] = std::max(big[c][j][l], std::abs(acc[j][l]) * inv);
+          }
       }
-    }
+    };
+    if (axes == 2)
+      derive.template operator()<2>();
+    else
+      derive.template operator()<3>();
   }
 
   // Products, then J_gamma = J^_gamma / mult(gamma), written element-major.
