@@ -203,8 +203,9 @@ void add_check_command(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--max-subdivisions", o->max_subdivisions,
-                  "Subdomains split per element before answering undetermined (mu, scaled\n"
-                  "Jacobian: before stopping with bounds wider than --tol, said in the summary)")
+                  "Subdivisions per element before answering undetermined (mu, scaled\n"
+                  "Jacobian: before stopping with bounds wider than --tol, said in the summary;\n"
+                  "where these halve a subdomain at a time, dim halvings count as one)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--threads", o->threads, "Threads at most (0: all cores; small meshes use fewer, as threads would cost more than they save); results do not depend on it")

@@ -21,8 +21,9 @@ namespace quadval {
 struct QualityOptions {
   /// Stop refining an element when upper - lower <= abs_tol (both measures are at most 1).
   double abs_tol = 1e-3;
-  /// Subdomains split per element; reaching it leaves bounds wider than asked
-  /// (tolerance_met = false), still certified.
+  /// Subdivisions per element (where a subdomain is halved at a time, dim halvings count
+  /// as one); reaching it leaves bounds wider than asked (tolerance_met = false), still
+  /// certified.
   int max_subdivisions = 1000;
 };
 
