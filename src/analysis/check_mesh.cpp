@@ -261,6 +261,12 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     }
   };
 
+  // A thread waiting on another (a batch's last chunk, a buffer to be handed out) sleeps in
+  // short steps rather than yielding in a loop: on an element that takes seconds the
+  // yields cost a core in system time (mixed_h0.6_o2, scaled Jacobian, 2 threads: 0.10 s
+  // of system time in a 0.20 s run). A step delays a flush by at most 20 microseconds.
+  const auto pause = [] { std::this_thread::sleep_for(std::chrono::microseconds(20)); };
+
 #pragma omp parallel num_threads(threads)
   {
     const bool master = omp_get_thread_num() == 0;
@@ -278,7 +284,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
       // Its chunks were all claimed before this one, so this always ends.
       while (batch >= flushed.load(std::memory_order_acquire) + buffers.size() && !failed) {
         if (master) flush_ready();
-        else std::this_thread::yield();
+        else pause();
       }
       if (failed) break;
       Buffer& buf = buffers[batch % buffers.size()];
@@ -441,7 +447,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     if (master)
       while (!failed && flushed.load(std::memory_order_relaxed) < num_batches) {
         flush_ready();
-        if (flushed.load(std::memory_order_relaxed) < num_batches) std::this_thread::yield();
+        if (flushed.load(std::memory_order_relaxed) < num_batches) pause();
       }
   }
   if (failure) std::rethrow_exception(failure);
