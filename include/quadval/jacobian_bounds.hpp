@@ -54,8 +54,9 @@ struct BoundsOptions {
   /// |jmax_lower|)) for both min J and max J (and the sign of min J is settled).
   double abs_tol = 0;
   double rel_tol = 1e-2;
-  /// Subdomains split per element and per refined quantity; reaching it gives
-  /// undetermined (validity) or bounds wider than asked (measure).
+  /// Subdivisions per element and per refined quantity (the refinement halves one
+  /// subdomain at a time by an edge bisection; dim halvings count as one subdivision);
+  /// reaching it gives undetermined (validity) or bounds wider than asked (measure).
   int max_subdivisions = 1000;
   /// Redo an element in exact rational arithmetic when rounding keeps its sign open.
   bool exact_fallback = true;
@@ -71,7 +72,7 @@ struct JacobianBounds {
   /// estimate, within the coefficients' rounding error.
   double javg = 0;
   Validity validity = Validity::undetermined;
-  int subdivisions = 0;  ///< subdomains split (for min J, plus for max J when measuring)
+  int subdivisions = 0;  ///< subdivisions (for min J, plus for max J when measuring)
   /// Which stage decided validity (Paper III Table 2): 0 the samples, 1 the first Bézier
   /// coefficients, 1 + k after k levels of subdivision; -1 when undetermined.
   int stage = -1;

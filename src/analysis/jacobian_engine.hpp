@@ -8,6 +8,7 @@
 #include <limits>
 #include <vector>
 
+#include "bezier/bernstein_bisection.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -19,7 +20,8 @@ struct BoundsWorkspace::Impl {
     double lower;  // certified lower bound of the polynomial on this subdomain
     double err;    // |computed - exact| bound of every coefficient
     int slot;      // coefficients at pool[slot * size]
-    int depth;
+    int depth;     // subdivisions from the root (levels halvings make one)
+    BisectionState state;
   };
   SampleScratch sample_scratch;
   std::vector<double> samples, errors, coeffs, scratch, straight_samples, straight_coeffs;
