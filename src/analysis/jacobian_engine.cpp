@@ -11,9 +11,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <memory>
-#include <mutex>
 #include <queue>
 
 #include "bezier/bezier_exact.hpp"
@@ -74,25 +71,6 @@ std::vector<mpq_class> exact_subdivide(const BezierBasis& b, const std::vector<m
                  all.begin() + static_cast<std::ptrdiff_t>(n * (static_cast<std::size_t>(digits[f]) + 1)));
     return block;
   });
-}
-
-// The bisection of a basis's space (the same factors and coefficient layout), built once
-// per basis on first use (thread-safe; each thread remembers the ones it used, lock-free).
-const BernsteinBisection& bisection_of(const BezierBasis& basis) {
-  thread_local std::vector<std::pair<const BezierBasis*, const BernsteinBisection*>> seen;
-  for (const auto& [b, bisection] : seen)
-    if (b == &basis) return *bisection;
-  static std::mutex mutex;
-  static std::map<const BezierBasis*, std::unique_ptr<const BernsteinBisection>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[&basis];
-  if (!slot) {
-    std::vector<FactorDegree> factors;
-    for (const BernsteinSimplex* f : basis.factors()) factors.push_back({f->dim(), f->degree()});
-    slot = std::make_unique<const BernsteinBisection>(std::move(factors));
-  }
-  seen.emplace_back(&basis, slot.get());
-  return *slot;
 }
 
 }  // namespace
@@ -164,7 +142,10 @@ MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, dou
     }
     if (ws.heap.empty() || halvings >= static_cast<long>(max_subdivisions) * levels) break;
     if (bisection == nullptr) {
-      bisection = &bisection_of(basis);
+      // Same factors and coefficient layout as the basis.
+      std::vector<FactorDegree> factors;
+      for (const BernsteinSimplex* f : basis.factors()) factors.push_back({f->dim(), f->degree()});
+      bisection = &bernstein_bisection(factors);
       levels = bisection->levels();
       ws.heap.front().state = bisection->root_state();  // the root, the only leaf so far
     }

@@ -6,9 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
-#include <memory>
-#include <mutex>
 #include <queue>
 #include <vector>
 
@@ -44,16 +41,6 @@ struct MuScratch {
   std::vector<std::array<double, 9>> corners;  // W at the corners bounded in this split
   std::vector<double> children;                // the children of the subdomain refined
 };
-
-// The bisection of W's space, built once per type (thread-safe).
-const BernsteinBisection& w_bisection(const MuSpace& space) {
-  static std::mutex mutex;
-  static std::map<const MuSpace*, std::unique_ptr<const BernsteinBisection>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[&space];
-  if (!slot) slot = std::make_unique<const BernsteinBisection>(space.degrees(1));
-  return *slot;
-}
 
 // W's control values of the whole element (layout of MuMetric::lower_bound) and their
 // error bound: X_c = D_c (x - x_0) within gamma_{N+4} Gamma_c R (D entries 2u, differences
@@ -223,7 +210,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // but tets_h0.8_o2 42 -> 71 ms (Maubach's children of a tetrahedron close the
   // control-matrix gap more slowly: 185 subdivisions instead of 113).
   const bool halving = type.family != ElementFamily::tetrahedron;
-  const BernsteinBisection& bisection = w_bisection(space);
+  const BernsteinBisection& bisection = bernstein_bisection(space.degrees(1));
   const long levels = halving ? bisection.levels() : 1;
   const auto children = static_cast<std::size_t>(halving ? 2 : basis.num_children());
   long steps = 0;

@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <memory>
+#include <mutex>
+#include <tuple>
 
 #include "quadval/error.hpp"
 
@@ -213,6 +216,18 @@ void BernsteinBisection::halve(const double* parent, std::size_t count, const Bi
   }
   states[0] = first;
   states[1] = second;
+}
+
+const BernsteinBisection& bernstein_bisection(std::span<const FactorDegree> factors) {
+  using Key = std::vector<std::pair<int, int>>;
+  static std::mutex mutex;
+  static std::map<Key, std::unique_ptr<const BernsteinBisection>> cache;
+  Key key;
+  for (const FactorDegree& f : factors) key.emplace_back(f.dim, f.degree);
+  std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[key];
+  if (!slot) slot = std::make_unique<const BernsteinBisection>(std::vector<FactorDegree>(factors.begin(), factors.end()));
+  return *slot;
 }
 
 }  // namespace quadval

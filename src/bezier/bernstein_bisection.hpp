@@ -130,4 +130,7 @@ class BernsteinBisection {
   double halving_relative_ = 0, halving_absolute_ = 0;  // the largest factor's one bisection
 };
 
+/// The shared bisection of the space with these factors; thread-safe, built once per key.
+const BernsteinBisection& bernstein_bisection(std::span<const FactorDegree> factors);
+
 }  // namespace quadval
