@@ -324,6 +324,20 @@ TEST(ScaledJacobian, FirstStageIsExactOnStraightElements) {
   EXPECT_GT(checked, 150);
 }
 
+// The first stage's bounds `stage` of element e enclose sj(E): lower <= upper, lower never
+// above the full certified upper bound nor the sampled minimum (pyramids: no sampler
+// here), upper never below the full certified lower bound.
+void expect_encloses(const ElementType& t, const std::vector<double>& x, const std::vector<RefPoint>& pts,
+                     const QualityBounds& stage, int e) {
+  const QualityBounds full = bounds(t, x, 1e-6);
+  EXPECT_LE(stage.lower, stage.upper);
+  EXPECT_LE(full.lower, stage.upper) << "element " << e;
+  EXPECT_LE(stage.lower, full.upper) << "element " << e;
+  if (t.family != ElementFamily::pyramid) {
+    EXPECT_LE(stage.lower, sampled_min(t, x, pts) + 1e-12) << "element " << e;
+  }
+}
+
 // The first stage on curved valid elements of every family (pyramids included) up to
 // order 3: its lower bound is never above the sampled minimum, its upper bound never below
 // the full certified lower bound (both enclose sj(E)); and on barely curved ones (node
@@ -343,13 +357,7 @@ TEST(ScaledJacobian, FirstStageBoundsEncloseSampledAndFullBounds) {
       const std::vector<double> x = test::smooth_random_element(t, amplitude, rng);
       const QualityBounds first = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1.0, 0);
       if (!std::isfinite(first.lower)) continue;  // J's least coefficient not positive
-      const QualityBounds full = bounds(t, x, 1e-6);
-      EXPECT_LE(first.lower, first.upper);
-      EXPECT_LE(full.lower, first.upper) << "element " << e;
-      EXPECT_LE(first.lower, full.upper) << "element " << e;
-      if (t.family != ElementFamily::pyramid) {
-        EXPECT_LE(first.lower, sampled_min(t, x, pts) + 1e-12) << "element " << e;
-      }
+      expect_encloses(t, x, pts, first, e);
       ++elements;
       if (amplitude == 1e-3) {
         ++barely;
@@ -377,15 +385,9 @@ TEST(ScaledJacobian, FirstStageRefinedEnclosesAndConverges) {
       const QualityBounds root = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1e-2, 0);
       const QualityBounds q = scaled_jacobian_quotient_stage(t, x, /*planar=*/true, 1e-2, 16);
       if (!std::isfinite(q.lower)) continue;
-      const QualityBounds full = bounds(t, x, 1e-6);
-      EXPECT_LE(q.lower, q.upper);
-      EXPECT_LE(full.lower, q.upper) << "element " << e;
-      EXPECT_LE(q.lower, full.upper) << "element " << e;
+      expect_encloses(t, x, pts, q, e);
       EXPECT_LE(q.subdivisions, 16);
       EXPECT_GE(q.lower, root.lower) << "element " << e;  // refining never loosens
-      if (t.family != ElementFamily::pyramid) {
-        EXPECT_LE(q.lower, sampled_min(t, x, pts) + 1e-12) << "element " << e;
-      }
       if (q.tolerance_met) {
         EXPECT_LE(q.upper - q.lower, 1e-2);
       }
