@@ -94,9 +94,10 @@ class BernsteinSimplex {
   }
   /// S_q (size x size, row-major): the child's Bézier coefficients = S_q * parent's
   /// (eq. 20). Entries are k / 2^n, nonnegative, each row sums to 1: exact in double.
-  std::span<const double> subdivision(int child) const noexcept;
+  /// Built on first use (thread-safe).
+  std::span<const double> subdivision(int child) const;
   /// S_q transposed.
-  std::span<const double> subdivision_transposed(int child) const noexcept;
+  std::span<const double> subdivision_transposed(int child) const;
 
  private:
   int dim_;
@@ -112,7 +113,9 @@ class BernsteinSimplex {
   mutable std::vector<double> to_lagrange_, to_lagrange_t_;
   std::unique_ptr<Exact> exact_;
   std::vector<std::array<std::array<int, 4>, 4>> children_;
-  std::vector<double> subdivision_, subdivision_t_;  // num_children blocks of size*size
+  void build_subdivision() const;
+  mutable std::once_flag subdivision_once_;
+  mutable std::vector<double> subdivision_, subdivision_t_;  // num_children blocks of size*size
 };
 
 /// Multi-indices of the Bernstein polynomials of degree n on the d-simplex (d = 0..3), in

@@ -596,16 +596,16 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
   const std::size_t axes = dim_ == 2 && planar ? 2 : 3;
   double* x = buf;
   double* range = x + n * 3 * w;
-  for (std::size_t j = 0; j < 3; ++j)
-    for (std::size_t l = 0; l < w; ++l) range[j * w + l] = 0;
   for (std::size_t l = 0; l < w; ++l) {
     const double* xe = nodes + l * stride;
+    double r[3] = {0, 0, 0};  // locals: stores to x could alias range[], so kept in memory
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t j = 0; j < axes; ++j) {
         const double d = xe[3 * i + j] - xe[j];
         x[(i * 3 + j) * w + l] = d;
-        range[j * w + l] = std::max(range[j * w + l], std::abs(d));
+        r[j] = std::max(r[j], std::abs(d));
       }
+    for (std::size_t j = 0; j < 3; ++j) range[j * w + l] = r[j];
   }
 
   // Derivative control points, scaled: d_ckj = sum_i G^_ki x_ij over the nonzero G^_ki in

@@ -164,68 +164,77 @@ BernsteinSimplex::BernsteinSimplex(int dim, int degree)
       if (alphas_[static_cast<std::size_t>(i)][static_cast<std::size_t>(a)] == degree)
         vertex_[static_cast<std::size_t>(i)] = true;
 
-  // Subdivision (eq. 20) by blossoming: the child's coefficient beta is the blossom of the
-  // parent at (w_0 repeated beta_0 times, ..., w_d repeated beta_d times), i.e. the
-  // coefficient of t^alpha in prod_k (w_k . t)^beta_k times the parent's b_alpha.
-  // With w in halves, the integer numerators sum to 2^n per row. The product is expanded
-  // densely over monomial codes (sum_a m_a base^a) in 64-bit integers: every partial
-  // product has nonnegative coefficients summing to 2^(factors so far) <= 2^60, so no
-  // overflow, and the final ones (< 2^53, checked) are exact in double. The exact rational
-  // copies are made only when the exact fallback asks for them (build_to_bezier).
   QV_ASSERT(degree <= 60, "degree too high for exact dyadic subdivision: " << degree);
   children_ = midpoint_children(dim);
-  const int base = degree + 1;
-  std::array<int, 4> place{1, 0, 0, 0};  // base^a
-  for (int a = 1; a <= dim; ++a) place[static_cast<std::size_t>(a)] = place[static_cast<std::size_t>(a - 1)] * base;
-  const int codes = place[static_cast<std::size_t>(dim)] * base;
-  std::vector<int> index_of(static_cast<std::size_t>(codes), -1);
-  const auto code = [&](const MultiIndex& a) {
-    int c = 0;
-    for (int x = 0; x <= dim; ++x) c += a[static_cast<std::size_t>(x)] * place[static_cast<std::size_t>(x)];
-    return c;
-  };
-  for (int i = 0; i < s; ++i) index_of[static_cast<std::size_t>(code(alphas_[static_cast<std::size_t>(i)]))] = i;
-  const double scale = std::ldexp(1.0, -degree);
-  subdivision_.assign(children_.size() * n_sz * n_sz, 0.0);
-  std::vector<std::int64_t> poly(static_cast<std::size_t>(codes), 0), next(poly.size(), 0);
-  std::vector<int> live, next_live;
-  for (std::size_t q = 0; q < children_.size(); ++q) {
-    for (int r = 0; r < s; ++r) {
-      const MultiIndex& beta = alphas_[static_cast<std::size_t>(r)];
-      live.assign(1, 0);
-      poly[0] = 1;
-      for (int k = 0; k <= dim; ++k) {
-        const auto& w = children_[q][static_cast<std::size_t>(k)];
-        for (int rep = 0; rep < beta[static_cast<std::size_t>(k)]; ++rep) {
-          next_live.clear();
-          for (const int c : live) {
-            const std::int64_t coef = poly[static_cast<std::size_t>(c)];
-            poly[static_cast<std::size_t>(c)] = 0;
-            for (int a = 0; a <= dim; ++a) {
-              const int wa = w[static_cast<std::size_t>(a)];
-              if (wa == 0) continue;
-              const auto nc = static_cast<std::size_t>(c + place[static_cast<std::size_t>(a)]);
-              if (next[nc] == 0) next_live.push_back(static_cast<int>(nc));
-              next[nc] += coef * wa;
+}
+
+void BernsteinSimplex::build_subdivision() const {
+  // Built on first use: a check whose elements all pass at the first Bézier stage never
+  // subdivides (9,647 quadratic tetrahedra: 0.15 ms of a 2 ms check were this).
+  std::call_once(subdivision_once_, [this] {
+    const int dim = dim_, degree = degree_, s = size();
+    const auto n_sz = static_cast<std::size_t>(s);
+    // Subdivision (eq. 20) by blossoming: the child's coefficient beta is the blossom of the
+    // parent at (w_0 repeated beta_0 times, ..., w_d repeated beta_d times), i.e. the
+    // coefficient of t^alpha in prod_k (w_k . t)^beta_k times the parent's b_alpha.
+    // With w in halves, the integer numerators sum to 2^n per row. The product is expanded
+    // densely over monomial codes (sum_a m_a base^a) in 64-bit integers: every partial
+    // product has nonnegative coefficients summing to 2^(factors so far) <= 2^60, so no
+    // overflow, and the final ones (< 2^53, checked) are exact in double. The exact rational
+    // copies are made only when the exact fallback asks for them (build_to_bezier).
+    const int base = degree + 1;
+    std::array<int, 4> place{1, 0, 0, 0};  // base^a
+    for (int a = 1; a <= dim; ++a) place[static_cast<std::size_t>(a)] = place[static_cast<std::size_t>(a - 1)] * base;
+    const int codes = place[static_cast<std::size_t>(dim)] * base;
+    std::vector<int> index_of(static_cast<std::size_t>(codes), -1);
+    const auto code = [&](const MultiIndex& a) {
+      int c = 0;
+      for (int x = 0; x <= dim; ++x) c += a[static_cast<std::size_t>(x)] * place[static_cast<std::size_t>(x)];
+      return c;
+    };
+    for (int i = 0; i < s; ++i) index_of[static_cast<std::size_t>(code(alphas_[static_cast<std::size_t>(i)]))] = i;
+    const double scale = std::ldexp(1.0, -degree);
+    subdivision_.assign(children_.size() * n_sz * n_sz, 0.0);
+    std::vector<std::int64_t> poly(static_cast<std::size_t>(codes), 0), next(poly.size(), 0);
+    std::vector<int> live, next_live;
+    for (std::size_t q = 0; q < children_.size(); ++q) {
+      for (int r = 0; r < s; ++r) {
+        const MultiIndex& beta = alphas_[static_cast<std::size_t>(r)];
+        live.assign(1, 0);
+        poly[0] = 1;
+        for (int k = 0; k <= dim; ++k) {
+          const auto& w = children_[q][static_cast<std::size_t>(k)];
+          for (int rep = 0; rep < beta[static_cast<std::size_t>(k)]; ++rep) {
+            next_live.clear();
+            for (const int c : live) {
+              const std::int64_t coef = poly[static_cast<std::size_t>(c)];
+              poly[static_cast<std::size_t>(c)] = 0;
+              for (int a = 0; a <= dim; ++a) {
+                const int wa = w[static_cast<std::size_t>(a)];
+                if (wa == 0) continue;
+                const auto nc = static_cast<std::size_t>(c + place[static_cast<std::size_t>(a)]);
+                if (next[nc] == 0) next_live.push_back(static_cast<int>(nc));
+                next[nc] += coef * wa;
+              }
             }
+            poly.swap(next);
+            live.swap(next_live);
           }
-          poly.swap(next);
-          live.swap(next_live);
+        }
+        for (const int c : live) {
+          const std::int64_t coef = poly[static_cast<std::size_t>(c)];
+          poly[static_cast<std::size_t>(c)] = 0;
+          const int col = index_of[static_cast<std::size_t>(c)];
+          QV_ASSERT(col >= 0, "monomial outside the space");
+          QV_ASSERT(coef > 0 && coef < (std::int64_t{1} << 53), "non-exact entry");
+          const std::size_t at = q * n_sz * n_sz + static_cast<std::size_t>(r) * n_sz +
+                                 static_cast<std::size_t>(col);
+          subdivision_[at] = static_cast<double>(coef) * scale;
         }
       }
-      for (const int c : live) {
-        const std::int64_t coef = poly[static_cast<std::size_t>(c)];
-        poly[static_cast<std::size_t>(c)] = 0;
-        const int col = index_of[static_cast<std::size_t>(c)];
-        QV_ASSERT(col >= 0, "monomial outside the space");
-        QV_ASSERT(coef > 0 && coef < (std::int64_t{1} << 53), "non-exact entry");
-        const std::size_t at = q * n_sz * n_sz + static_cast<std::size_t>(r) * n_sz +
-                               static_cast<std::size_t>(col);
-        subdivision_[at] = static_cast<double>(coef) * scale;
-      }
     }
-  }
-  subdivision_t_ = transpose_blocks(subdivision_, n_sz);
+    subdivision_t_ = transpose_blocks(subdivision_, n_sz);
+  });
 }
 
 void BernsteinSimplex::build_to_lagrange() const {
@@ -318,6 +327,7 @@ const BernsteinSimplex::Exact& BernsteinSimplex::exact() const {
   build_to_bezier();
   // The dyadic subdivision entries are exact in double (constructor), hence as rationals;
   // copied only here, not for lagrange_to_bezier(), which the sampled path needs.
+  build_subdivision();
   std::call_once(exact_->subdivision_once, [this] {
     exact_->subdivision.resize(subdivision_.size());
     for (std::size_t i = 0; i < subdivision_.size(); ++i) exact_->subdivision[i] = subdivision_[i];
@@ -367,12 +377,14 @@ void BernsteinSimplex::evaluate(std::span<const double> xi, std::span<double> va
   }
 }
 
-std::span<const double> BernsteinSimplex::subdivision_transposed(int child) const noexcept {
+std::span<const double> BernsteinSimplex::subdivision_transposed(int child) const {
+  build_subdivision();
   const auto n = static_cast<std::size_t>(size()) * static_cast<std::size_t>(size());
   return {subdivision_t_.data() + static_cast<std::size_t>(child) * n, n};
 }
 
-std::span<const double> BernsteinSimplex::subdivision(int child) const noexcept {
+std::span<const double> BernsteinSimplex::subdivision(int child) const {
+  build_subdivision();
   const auto n = static_cast<std::size_t>(size()) * static_cast<std::size_t>(size());
   return {subdivision_.data() + static_cast<std::size_t>(child) * n, n};
 }

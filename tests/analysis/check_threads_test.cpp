@@ -25,19 +25,19 @@ TEST(CheckThreads, SmallMeshRunsOnOneThread) {
   const Mesh mesh = random_mesh(*find_element_type(ElementFamily::tetrahedron, 2, true), 600, 1);
   CheckOptions o;
   o.threads = 4;
-  EXPECT_EQ(check_mesh(mesh, o).threads, 1);  // 600 x 10 nodes x 20 coefficients: ~0.1 ms
+  EXPECT_EQ(check_mesh(mesh, o).threads, 1);  // 600 x 10 nodes x 20 coefficients: ~0.1 ms of work
 }
 
 TEST(CheckThreads, LargeWorkUsesThreadsWithIdenticalAnswers) {
-  // Validity: 8000 x 20 nodes x 84 coefficients = 1.3e7 work units, two threads' worth.
-  const Mesh mesh = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 8000, 2);
+  // Validity: 3000 x 20 nodes x 84 coefficients = 5.04e6 work units, six threads' worth.
+  const Mesh mesh = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 3000, 2);
   CheckOptions o;
   o.threads = 1;
   const CheckReport one = check_mesh(mesh, o);
-  o.threads = 8;  // capped by the work, not by the chunks (32)
+  o.threads = 8;  // capped by the work, not by the chunks (12)
   const CheckReport many = check_mesh(mesh, o);
   EXPECT_EQ(one.threads, 1);
-  EXPECT_EQ(many.threads, 2);
+  EXPECT_EQ(many.threads, 6);
   ASSERT_EQ(one.elements.size(), many.elements.size());
   std::size_t answers[3] = {0, 0, 0};
   for (std::size_t e = 0; e < one.elements.size(); ++e) {
@@ -58,18 +58,22 @@ TEST(CheckThreads, LargeWorkUsesThreadsWithIdenticalAnswers) {
 }
 
 TEST(CheckThreads, MeasuringCountsAsMoreWork) {
-  // Measuring weighs 50 times validity: 600 tetrahedra of order 2, 600 x 200 x 50 = 6e6
-  // units, stay on one thread.
-  const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 2, true), 600, 3);
+  // One thread per 1e6 units (node x J coefficient, weighed 50 times when measuring),
+  // capped by the chunks of 256 elements and by the threads requested. 300 tetrahedra of
+  // order 2 (two chunks): 300 x 10 x 20 = 6e4 units for validity, one thread; 3e6
+  // measuring, capped by the two chunks.
+  const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 2, true), 300, 3);
   CheckOptions o;
   o.threads = 8;
-  o.measure = CheckMeasure::jacobian;
+  o.measure = CheckMeasure::validity;
   EXPECT_EQ(check_mesh(small, o).threads, 1);
-  // 3000 tetrahedra of order 3: 3000 x 1680 = 5e6 units for validity (one thread), 2.5e8
-  // measuring: 25 threads' worth, capped by the 12 chunks, then by the 8 requested.
+  o.measure = CheckMeasure::jacobian;
+  EXPECT_EQ(check_mesh(small, o).threads, 2);
+  // 3000 tetrahedra of order 3 (12 chunks): 3000 x 20 x 84 = 5.04e6 units for validity,
+  // six threads; 2.5e8 measuring: capped by the 8 requested.
   const Mesh big = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 3000, 4);
   o.measure = CheckMeasure::validity;
-  EXPECT_EQ(check_mesh(big, o).threads, 1);
+  EXPECT_EQ(check_mesh(big, o).threads, 6);
   o.measure = CheckMeasure::jacobian;
   EXPECT_EQ(check_mesh(big, o).threads, 8);
 }
