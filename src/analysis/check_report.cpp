@@ -188,7 +188,7 @@ bool measures_distortion(CheckMeasure m) noexcept {
 std::string format_check_summary(const CheckSummary& r, std::size_t worst) {
   std::string out;
   auto line = [&out](const std::string& s) { out += s + "\n"; };
-  line(fmt::format("[check] {}: {} elements of dimension {}{}, measure {}, {} thread{}, {:.3f} s",
+  line(fmt::format("[check] {}: {} elements of dimension {}{}, measure {}, {} thread{}, {:.3g} s",
                    r.file, r.elements, r.dimension,
                    r.dimension == 2 ? (r.planar ? " (planar: J with n = +z)" : " (J with each element's normal)") : "",
                    measure_name(r.measure), r.threads, r.threads == 1 ? "" : "s", r.seconds));
