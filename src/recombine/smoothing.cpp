@@ -60,12 +60,16 @@ bool can_slide(NodeIndex v, const std::vector<char>& fixed, const SmoothingOptio
 
 /// Everything smooth() needs that the moves do not change (the topology is fixed here): per
 /// node its alive elements and, per element, its two edge neighbours there; the movable nodes
-/// in node order (the sweep order).
+/// and the sweep's blocks and colours (smoothing_order).
 struct SmoothingTopology {
   std::vector<std::uint32_t> star_offsets;             ///< #nodes + 1
   std::vector<std::uint32_t> star;                     ///< local ids of the elements at each node
   std::vector<std::array<NodeIndex, 2>> star_sides;    ///< per star entry: next, prev corner
   std::vector<NodeIndex> order;                        ///< movable nodes, ascending
+  /// Blocks: runs of SmoothingOptions::block consecutive entries of `order`, block b being
+  /// order[b * block, ...). Colours: blocks[color_first[c] .. color_first[c + 1]) are the
+  /// blocks of colour c, ascending; two blocks of one colour share no element.
+  std::vector<std::uint32_t> blocks, color_first;
   /// Local id -> element of m: the alive elements in the order the sweep first meets them,
   /// so that a sweep reads their data nearly in memory order (m's order, after matching and
   /// repair, scatters them: cache misses).
@@ -99,7 +103,37 @@ SmoothingTopology build_topology(const MixedMesh& m, const std::vector<char>& fi
     if ((!fixed[v] || can_slide(v, fixed, options)) && t.star_offsets[v] < t.star_offsets[v + 1])
       t.order.push_back(v);
 
+  // Greedy colours of the blocks, in block order: the smallest colour that no earlier block
+  // sharing an element with this one has. Nodes follow a space-filling curve
+  // (order_nodes_along_curve), so a block is a compact patch and has few neighbours.
   constexpr std::uint32_t kUnset = 0xffffffffu;
+  const std::size_t block = static_cast<std::size_t>(std::max(1, options.block));
+  const std::size_t num_blocks = (t.order.size() + block - 1) / block;
+  std::vector<std::uint32_t> block_of(n, kUnset), color(num_blocks, 0), seen;
+  for (std::size_t k = 0; k < t.order.size(); ++k) block_of[t.order[k]] = static_cast<std::uint32_t>(k / block);
+  std::uint32_t colors = 0;
+  for (std::size_t b = 0; b < num_blocks; ++b) {
+    seen.assign(colors + 1, 0);
+    for (std::size_t k = b * block; k < std::min(t.order.size(), (b + 1) * block); ++k) {
+      const NodeIndex v = t.order[k];
+      for (std::uint32_t i = t.star_offsets[v]; i < t.star_offsets[v + 1]; ++i) {
+        const auto& el = m.elements[t.star[i]];
+        for (int c = 0; c < MixedMesh::size(el); ++c) {
+          const std::uint32_t other = block_of[el[c]];
+          if (other != kUnset && other < b) seen[color[other]] = 1;
+        }
+      }
+    }
+    color[b] = static_cast<std::uint32_t>(std::find(seen.begin(), seen.end(), 0) - seen.begin());
+    colors = std::max(colors, color[b] + 1);
+  }
+  t.color_first.assign(colors + 1, 0);
+  for (std::uint32_t c : color) ++t.color_first[c + 1];
+  for (std::uint32_t c = 0; c < colors; ++c) t.color_first[c + 1] += t.color_first[c];
+  t.blocks.resize(num_blocks);
+  std::vector<std::uint32_t> next(t.color_first.begin(), t.color_first.end() - 1);
+  for (std::size_t b = 0; b < num_blocks; ++b) t.blocks[next[color[b]]++] = static_cast<std::uint32_t>(b);
+
   std::vector<std::uint32_t> local(m.elements.size(), kUnset);
   auto number = [&](std::uint32_t e) {
     if (local[e] != kUnset) return;
@@ -244,14 +278,26 @@ bool Smoother::try_move(NodeIndex v, bool raise_mean, double global_min,
 
 std::size_t Smoother::run() {
   std::size_t accepted = 0;
-  std::vector<double> trial;
+  const std::size_t block = static_cast<std::size_t>(std::max(1, options_.block));
   for (int pass = 0; pass < 2 * options_.passes; ++pass) {
     const bool raise_mean = pass >= options_.passes;
     double global_min = 2.0;
     for (double s : score_) global_min = std::min(global_min, s);
     std::size_t accepted_this_pass = 0;
-    for (NodeIndex v : topo_.order)
-      if (try_move(v, raise_mean, global_min, trial)) ++accepted_this_pass;
+    // The blocks of one colour share no element: a move reads and writes only its node's
+    // elements and their corners, so they go in parallel, and the result is that of the
+    // sweep in smoothing_order for any number of threads.
+    for (std::size_t c = 0; c + 1 < topo_.color_first.size(); ++c) {
+      const auto first = static_cast<std::ptrdiff_t>(topo_.color_first[c]);
+      const auto last = static_cast<std::ptrdiff_t>(topo_.color_first[c + 1]);
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : accepted_this_pass) if (last - first > 1)
+      for (std::ptrdiff_t i = first; i < last; ++i) {
+        std::vector<double> trial;
+        const std::size_t b = topo_.blocks[static_cast<std::size_t>(i)];
+        for (std::size_t k = b * block; k < std::min(topo_.order.size(), (b + 1) * block); ++k)
+          if (try_move(topo_.order[k], raise_mean, global_min, trial)) ++accepted_this_pass;
+      }
+    }
     accepted += accepted_this_pass;
     if (accepted_this_pass == 0 && raise_mean) break;
   }
@@ -263,6 +309,22 @@ std::size_t Smoother::run() {
 std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options) {
   if (options.passes <= 0) return 0;
   return Smoother(m, fixed, options).run();
+}
+
+SmoothingSweep smoothing_order(const MixedMesh& m, const std::vector<char>& fixed,
+                               const SmoothingOptions& options) {
+  const SmoothingTopology t = build_topology(m, fixed, options);
+  const std::size_t block = static_cast<std::size_t>(std::max(1, options.block));
+  SmoothingSweep out;
+  for (std::size_t c = 0; c + 1 < t.color_first.size(); ++c)
+    for (std::uint32_t i = t.color_first[c]; i < t.color_first[c + 1]; ++i) {
+      const std::size_t b = t.blocks[i];
+      for (std::size_t k = b * block; k < std::min(t.order.size(), (b + 1) * block); ++k) {
+        out.nodes.push_back(t.order[k]);
+        out.colors.push_back(static_cast<std::uint32_t>(c));
+      }
+    }
+  return out;
 }
 
 std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,

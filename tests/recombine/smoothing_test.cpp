@@ -1,8 +1,9 @@
 // Smoothing (Paper I §6). smoothing_score equals element_score bit for bit (closed forms and
 // random quads, valid, reflex, inverted, degenerate). smooth() gives, bit for bit, what the
-// plain sweep of its doc comment gives (written out here with element_score, node_elements
-// and corner_of: none of smooth()'s shortcuts), never lowers the worst score and inverts
-// nothing. The last polish of the worst elements (polish_worst): a closed form, one interior
+// plain sweep of its doc comment gives in smoothing_order (written out here with
+// element_score, node_elements and corner_of: none of smooth()'s shortcuts), on one thread
+// or two; smoothing_order visits every movable node once and no two blocks of one colour
+// share an element; smooth() never lowers the worst score and inverts nothing. The last polish of the worst elements (polish_worst): a closed form, one interior
 // node pulled off the centre of 2 x 2 unit squares goes back to where all four are squares.
 #include <algorithm>
 #include <cmath>
@@ -10,6 +11,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include "recombine/boundary_slide.hpp"
 #include "recombine/smoothing.hpp"
@@ -74,10 +76,11 @@ TEST(SmoothingScore, EqualsElementScoreBitForBit) {
   EXPECT_GT(invalid, 2000);
 }
 
-// The sweep of smooth()'s doc comment, written the plain way: every node in node order, every
-// pass, element_score of every element at the node for each trial.
+// The sweep of smooth()'s doc comment, written the plain way: every node in smoothing_order,
+// one at a time, every pass, element_score of every element at the node for each trial.
 std::size_t plain_smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& o) {
   const auto at = node_elements(m);
+  const std::vector<NodeIndex> order = smoothing_order(m, fixed, o).nodes;
   std::vector<double> score(m.elements.size(), 0.0);
   for (std::size_t e = 0; e < m.elements.size(); ++e)
     if (m.alive[e]) score[e] = element_score(m, e);
@@ -88,7 +91,7 @@ std::size_t plain_smooth(MixedMesh& m, const std::vector<char>& fixed, const Smo
     for (std::size_t e = 0; e < m.elements.size(); ++e)
       if (m.alive[e]) global_min = std::min(global_min, score[e]);
     std::size_t this_pass = 0;
-    for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
+    for (NodeIndex v : order) {
       const bool sliding = fixed[v] && o.slides != nullptr && (*o.slides)[v][0] != kNoNode;
       if ((fixed[v] && !sliding) || at[v].empty()) continue;
       const auto x = m.point(v);
@@ -193,21 +196,97 @@ double worst_alive_score(const MixedMesh& m) {
 TEST(Smooth, SameBitsAsThePlainSweep) {
   const SizeFunction size = [](double x, double y, double) { return 0.5 + 0.1 * x + 0.05 * y; };
   for (unsigned seed = 1; seed <= 6; ++seed) {
-    const MixedMesh start = jittered_mixed_grid(9, 7, seed % 2 ? 0.3 : 0.55, seed);
-    const std::vector<char> fixed = region_boundary_nodes(start);
-    const auto slides = straight_boundary_slides(start, fixed);
-    SmoothingOptions options;
-    options.passes = 4;
-    options.slides = &slides;
-    if (seed > 3) options.size_field = &size;
-    MixedMesh fast = start, plain = start;
-    const std::size_t moves = smooth(fast, fixed, options);
-    EXPECT_EQ(moves, plain_smooth(plain, fixed, options)) << "seed " << seed;
-    EXPECT_GT(moves, 0u);
-    ASSERT_EQ(fast.coords.size(), plain.coords.size());
-    for (std::size_t i = 0; i < fast.coords.size(); ++i)
-      ASSERT_EQ(fast.coords[i], plain.coords[i]) << "seed " << seed << " coordinate " << i;
+    // Blocks of 512 (the default: one block here) and of 5 nodes (many blocks and colours).
+    for (int block : {512, 5}) {
+      const MixedMesh start = jittered_mixed_grid(9, 7, seed % 2 ? 0.3 : 0.55, seed);
+      const std::vector<char> fixed = region_boundary_nodes(start);
+      const auto slides = straight_boundary_slides(start, fixed);
+      SmoothingOptions options;
+      options.passes = 4;
+      options.slides = &slides;
+      options.block = block;
+      if (seed > 3) options.size_field = &size;
+      MixedMesh fast = start, plain = start;
+      const std::size_t moves = smooth(fast, fixed, options);
+      EXPECT_EQ(moves, plain_smooth(plain, fixed, options)) << "seed " << seed;
+      EXPECT_GT(moves, 0u);
+      ASSERT_EQ(fast.coords.size(), plain.coords.size());
+      for (std::size_t i = 0; i < fast.coords.size(); ++i)
+        ASSERT_EQ(fast.coords[i], plain.coords[i]) << "seed " << seed << " block " << block << " coordinate " << i;
+    }
   }
+}
+
+TEST(Smooth, OrderVisitsEveryMovableNodeOnceAndColoursDoNotTouch) {
+  const MixedMesh m = jittered_mixed_grid(30, 20, 0.3, 3);
+  const std::vector<char> fixed = region_boundary_nodes(m);
+  const auto slides = straight_boundary_slides(m, fixed);
+  const auto at = node_elements(m);
+  for (int block : {512, 40, 7, 1}) {
+    SmoothingOptions options;
+    options.slides = &slides;
+    options.block = block;
+    const SmoothingSweep sweep = smoothing_order(m, fixed, options);
+    const std::vector<NodeIndex>& order = sweep.nodes;
+    ASSERT_EQ(sweep.colors.size(), order.size());
+    // Every node with an element that is free or slides, once.
+    std::vector<int> seen(m.num_nodes(), 0);
+    for (NodeIndex v : order) ++seen[v];
+    for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
+      const bool movable = !at[v].empty() && (!fixed[v] || slides[v][0] != kNoNode);
+      EXPECT_EQ(seen[v], movable ? 1 : 0) << "block " << block << " node " << v;
+    }
+    // Colour by colour; blocks are runs of `block` movable nodes in node order, each within
+    // one colour, its nodes in node order; no element has corners in two different blocks of
+    // one colour.
+    std::vector<NodeIndex> movable;
+    for (NodeIndex v = 0; v < m.num_nodes(); ++v)
+      if (seen[v]) movable.push_back(v);
+    std::vector<std::size_t> block_of(m.num_nodes(), SIZE_MAX), color_of(m.num_nodes(), SIZE_MAX);
+    for (std::size_t k = 0; k < movable.size(); ++k) block_of[movable[k]] = k / static_cast<std::size_t>(block);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      color_of[order[k]] = sweep.colors[k];
+      if (k > 0) {
+        EXPECT_LE(sweep.colors[k - 1], sweep.colors[k]);
+        if (block_of[order[k - 1]] == block_of[order[k]]) {
+          EXPECT_LT(order[k - 1], order[k]);
+          EXPECT_EQ(sweep.colors[k - 1], sweep.colors[k]);
+        }
+      }
+    }
+    const std::size_t color = sweep.colors.empty() ? 0 : sweep.colors.back();
+    for (std::size_t e = 0; e < m.elements.size(); ++e) {
+      if (!m.alive[e]) continue;
+      for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i)
+        for (int j = 0; j < MixedMesh::size(m.elements[e]); ++j) {
+          const NodeIndex a = m.elements[e][i], b = m.elements[e][j];
+          if (!seen[a] || !seen[b] || block_of[a] == block_of[b]) continue;
+          EXPECT_NE(color_of[a], color_of[b]) << "element " << e << " block " << block;
+        }
+    }
+    if (block < 40) EXPECT_GT(color, 0u) << "several colours expected with blocks of " << block;
+  }
+}
+
+TEST(Smooth, SameBitsOnOneThreadOrTwo) {
+  const SizeFunction size = [](double x, double y, double) { return 0.5 + 0.02 * x + 0.01 * y; };
+  MixedMesh one = jittered_mixed_grid(40, 30, 0.35, 11);
+  const std::vector<char> fixed = region_boundary_nodes(one);
+  const auto slides = straight_boundary_slides(one, fixed);
+  SmoothingOptions options;
+  options.slides = &slides;
+  options.size_field = &size;
+  options.block = 16;
+  MixedMesh two = one;
+  const int threads = omp_get_max_threads();
+  omp_set_num_threads(1);
+  const std::size_t moves_one = smooth(one, fixed, options);
+  omp_set_num_threads(2);
+  const std::size_t moves_two = smooth(two, fixed, options);
+  omp_set_num_threads(threads);
+  EXPECT_GT(moves_one, 0u);
+  EXPECT_EQ(moves_one, moves_two);
+  for (std::size_t i = 0; i < one.coords.size(); ++i) ASSERT_EQ(one.coords[i], two.coords[i]) << "coordinate " << i;
 }
 
 TEST(Smooth, NeverLowersTheWorstScoreNorInverts) {
