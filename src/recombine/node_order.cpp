@@ -6,6 +6,8 @@
 #include <limits>
 #include <numeric>
 
+#include "quadval/error.hpp"
+
 namespace quadval::recombine_detail {
 
 namespace {
@@ -67,6 +69,28 @@ void order_nodes_along_curve(TriangleSurface& s) {
   s.node_tags = std::move(tags);
   for (auto& t : s.triangles)
     for (NodeIndex& v : t) v = new_index[v];
+}
+
+void order_triangles_along_curve(TriangleSurface& s) {
+  QV_ASSERT(s.forbidden_pairs.empty(), "triangles reordered after parity splits");
+  const std::size_t nt = s.triangles.size();
+  // A counting sort by the smallest node (stable, linear).
+  std::vector<std::uint32_t> first(s.node_tags.size() + 1, 0), order(nt);
+  const auto lowest = [&](std::size_t t) {
+    return std::min({s.triangles[t][0], s.triangles[t][1], s.triangles[t][2]});
+  };
+  for (std::size_t t = 0; t < nt; ++t) ++first[lowest(t) + 1];
+  for (std::size_t v = 0; v + 1 < first.size(); ++v) first[v + 1] += first[v];
+  for (std::size_t t = 0; t < nt; ++t) order[first[lowest(t)]++] = static_cast<std::uint32_t>(t);
+  const auto permute = [&](auto& v) {
+    std::remove_reference_t<decltype(v)> out(v.size());
+    for (std::size_t i = 0; i < nt; ++i) out[i] = v[order[i]];
+    v = std::move(out);
+  };
+  permute(s.triangles);
+  permute(s.region);
+  permute(s.triangle_tags);
+  permute(s.input_index);
 }
 
 }  // namespace quadval::recombine_detail

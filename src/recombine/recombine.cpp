@@ -176,6 +176,7 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
 
   TriangleSurface s = prepare_triangles(input, options.source, result.warnings);
   order_nodes_along_curve(s);  // memory locality; the output keeps the input's node order
+  order_triangles_along_curve(s);
   stats.input_triangles = s.triangles.size();
   if (options.cost == PairCostKind::cross_field && !options.cross_field_per_triangle.empty() &&
       options.cross_field_per_triangle.size() != s.triangles.size())

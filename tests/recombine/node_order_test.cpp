@@ -1,6 +1,8 @@
 // The nodes renumbered along the Z-order curve (node_order.hpp): a permutation that keeps
 // every node's tag with its coordinates, in the order of a hand-computed Morton key; and the
-// recombined mesh lists its nodes by increasing tag whatever the internal order.
+// recombined mesh lists its nodes by increasing tag whatever the internal order. The
+// triangles then in the order of their smallest node, stable, each carrying its region, tag
+// and input index.
 #include "recombine/node_order.hpp"
 
 #include <algorithm>
@@ -117,6 +119,31 @@ TEST(NodeOrder, RecombinedMeshListsNodesByIncreasingTag) {
     const RecombineResult r = recombine(in, {});
     ASSERT_FALSE(r.mesh.node_tags.empty());
     EXPECT_TRUE(std::is_sorted(r.mesh.node_tags.begin(), r.mesh.node_tags.end())) << seed;
+  }
+}
+
+TEST(NodeOrder, TrianglesFollowTheirSmallestNodeStably) {
+  // Six triangles over 8 nodes; smallest nodes 5, 0, 2, 0, 5, 1 (by hand).
+  TriangleSurface s;
+  for (int i = 0; i < 8; ++i) {
+    s.coords.insert(s.coords.end(), {double(i), 0.0, 0.0});
+    s.node_tags.push_back(i + 1);
+  }
+  s.triangles = {{5, 6, 7}, {3, 0, 4}, {2, 7, 3}, {6, 4, 0}, {7, 5, 6}, {1, 2, 3}};
+  s.region = {10, 11, 12, 13, 14, 15};
+  s.triangle_tags = {20, 21, 22, 23, 24, 25};
+  s.input_index = {0, 1, 2, 3, 4, 5};
+  order_triangles_along_curve(s);
+  // Keys 0 (inputs 1, 3 in that order), 1 (5), 2 (2), 5 (0, 4 in that order).
+  const std::vector<std::uint32_t> expected = {1, 3, 5, 2, 0, 4};
+  const std::vector<std::array<NodeIndex, 3>> input = {{5, 6, 7}, {3, 0, 4}, {2, 7, 3},
+                                                       {6, 4, 0}, {7, 5, 6}, {1, 2, 3}};
+  ASSERT_EQ(s.triangles.size(), expected.size());
+  for (std::size_t i = 0; i < expected.size(); ++i) {
+    EXPECT_EQ(s.input_index[i], expected[i]) << i;
+    EXPECT_EQ(s.triangles[i], input[expected[i]]) << i;  // corners and orientation kept
+    EXPECT_EQ(s.region[i], static_cast<std::int32_t>(10 + expected[i])) << i;
+    EXPECT_EQ(s.triangle_tags[i], static_cast<Tag>(20 + expected[i])) << i;
   }
 }
 
