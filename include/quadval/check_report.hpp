@@ -185,7 +185,10 @@ struct CheckSummary {
   std::map<int, std::array<std::size_t, 4>> counts;  ///< as CheckReport::counts
   std::vector<StageRow> stages;
   std::size_t exact_fallbacks = 0;
-  double seconds = 0;  ///< wall time of the analysis (a sink's time excluded)
+  /// Wall time of the analysis, a sink's time excluded, but never less than its set-up plus
+  /// the threads' analysing time over the thread count (other threads go on while the
+  /// calling thread runs the sink).
+  double seconds = 0;
   int threads = 1;
   /// Of the analysed elements' scale-free quality: distortion lower bound when measured,
   /// else ratio_lower (NaN: undefined).

@@ -7,7 +7,9 @@
 #include <array>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <ostream>
+#include <sstream>
 #include <tuple>
 #include <vector>
 #include <nlohmann/json.hpp>
@@ -19,7 +21,9 @@ namespace {
 
 const char* measure_name(CheckMeasure m) { return check_measure_name(m); }
 
-std::string num(double x) { return std::isnan(x) ? "nan" : fmt::format("{:.17g}", x); }
+// A double for CSV: fmt's {} prints the shortest text that reads back to the same double,
+// and "nan" for a NaN without its sign bit ("-nan" with it, as 0/0 gives on x86).
+double num(double x) { return std::isnan(x) ? std::numeric_limits<double>::quiet_NaN() : x; }
 
 const char* answer(const ElementCheck& e) {
   return e.analysed ? validity_name(e.bounds.validity) : "skipped";
@@ -69,27 +73,55 @@ void quality_section(std::string& out, const CheckSummary& r, bool sj, std::size
 }
 
 // One element's JSON object (check_json's "elements" entries).
-nlohmann::json element_json(const ElementCheck& e, const DistortionBounds& d, const QualityBounds& mu,
-                            const QualityBounds& sj) {
-  using nlohmann::json;
-  const auto jnum = [](double x) { return std::isnan(x) ? json(nullptr) : json(x); };
-  const JacobianBounds& b = e.bounds;
-  json je = {{"tag", e.tag}, {"type", e.type->gmsh_id}, {"validity", answer(e)}};
+// One element of the JSON "elements" array, in the layout of nlohmann::json::dump(1) nested
+// two levels deep (keys sorted), written straight into `out`: the DOM and its dump took 5 s
+// for a million elements. Non-finite doubles are null, as nlohmann writes them; the others
+// the shortest text that reads back to the same double.
+void append_element_json(std::string& out, const ElementCheck& e, const DistortionBounds& d,
+                         const QualityBounds& mu, const QualityBounds& sj) {
+  auto it = std::back_inserter(out);
+  const auto number = [&](double x) {
+    if (std::isfinite(x))
+      fmt::format_to(it, "{}", x);
+    else
+      out += "null";
+  };
+  const auto pair = [&](const char* key, double lo, double hi) {
+    fmt::format_to(it, "   \"{}\": [\n    ", key);
+    number(lo);
+    out += ",\n    ";
+    number(hi);
+    out += "\n   ],\n";
+  };
+  const auto field = [&](const char* key, double x) {
+    fmt::format_to(it, "   \"{}\": ", key);
+    number(x);
+    out += ",\n";
+  };
+  const auto quality = [&](const char* key, const QualityBounds& q) {
+    if (std::isnan(q.lower)) return;
+    fmt::format_to(it, "   \"{}\": {{\n    \"lower\": ", key);
+    number(q.lower);
+    fmt::format_to(it, ",\n    \"subdivisions\": {},\n    \"tolerance_met\": {},\n    \"upper\": ", q.subdivisions,
+                   q.tolerance_met);
+    number(q.upper);
+    out += "\n   },\n";
+  };
+  out += "{\n";
   if (e.analysed) {
-    je["jmin"] = {jnum(b.jmin_lower), jnum(b.jmin_upper)};
-    je["jmax"] = {jnum(b.jmax_lower), jnum(b.jmax_upper)};
-    je["distortion"] = {jnum(d.lower), jnum(d.upper)};
-    je["ratio_lower"] = jnum(e.ratio_lower());
-    je["jmin_over_javg"] = jnum(e.jmin_over_javg());
-    je["subdivisions"] = b.subdivisions;
-    je["stage"] = b.stage;
-    je["exact"] = b.exact;
-    for (const auto& [name, q] : {std::pair{"mu", mu}, std::pair{"sj", sj}})
-      if (!std::isnan(q.lower))
-        je[name] = {{"lower", q.lower}, {"upper", q.upper}, {"subdivisions", q.subdivisions},
-                    {"tolerance_met", q.tolerance_met}};
+    const JacobianBounds& b = e.bounds;
+    pair("distortion", d.lower, d.upper);
+    fmt::format_to(it, "   \"exact\": {},\n", b.exact);
+    pair("jmax", b.jmax_lower, b.jmax_upper);
+    pair("jmin", b.jmin_lower, b.jmin_upper);
+    field("jmin_over_javg", e.jmin_over_javg());
+    quality("mu", mu);
+    field("ratio_lower", e.ratio_lower());
+    quality("sj", sj);
+    fmt::format_to(it, "   \"stage\": {},\n   \"subdivisions\": {},\n", b.stage, b.subdivisions);
   }
-  return je;
+  fmt::format_to(it, "   \"tag\": {},\n   \"type\": {},\n   \"validity\": \"{}\"\n  }}", e.tag, e.type->gmsh_id,
+                 answer(e));
 }
 
 // check_json's "summary" object.
@@ -144,10 +176,13 @@ void csv_row(std::string& out, const ElementCheck& e, const DistortionBounds& d,
     out += fmt::format("{},{},skipped,nan,nan,nan,nan,nan,0,nan,nan,nan,-1,0,nan,nan,nan,nan\n", e.tag, e.type->gmsh_id);
     return;
   }
-  out += fmt::format("{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag, e.type->gmsh_id, answer(e),
-                     num(b.jmin_lower), num(b.jmin_upper), num(b.jmax_lower), num(b.jmax_upper), num(d.lower),
-                     b.subdivisions, num(d.upper), num(e.jmin_over_javg()), num(e.ratio_lower()), b.stage,
-                     b.exact ? 1 : 0, num(mu.lower), num(mu.upper), num(sj.lower), num(sj.upper));
+  // Doubles printed shortest (fmt's {} reads back exactly, and prints nan and inf as such),
+  // straight into `out`: a million rows in about 0.3 s instead of 2-3 s.
+  fmt::format_to(std::back_inserter(out), "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}\n", e.tag,
+                 e.type->gmsh_id, answer(e), num(b.jmin_lower), num(b.jmin_upper), num(b.jmax_lower),
+                 num(b.jmax_upper), num(d.lower), b.subdivisions, num(d.upper), num(e.jmin_over_javg()),
+                 num(e.ratio_lower()), b.stage, b.exact ? 1 : 0, num(mu.lower), num(mu.upper), num(sj.lower),
+                 num(sj.upper));
 }
 
 // `text` with `pad` spaces after every line break (nesting a dump(1) one level deeper).
@@ -267,11 +302,16 @@ std::string check_csv(const CheckReport& r) {
 }
 
 std::string check_json(const CheckReport& r) {
-  using nlohmann::json;
-  json elements = json::array();
-  for (std::size_t i = 0; i < r.elements.size(); ++i)
-    elements.push_back(element_json(r.elements[i], r.distortion_of(i), r.mu_of(i), r.sj_of(i)));
-  return json({{"summary", summary_json(summarize(r, 10))}, {"elements", elements}}).dump(1) + "\n";
+  std::ostringstream out;
+  CheckJsonWriter writer(out);
+  CheckBatch all;
+  all.elements = r.elements;
+  all.distortion = r.distortion;
+  all.mu = r.mu;
+  all.sj = r.sj;
+  writer.add(all);
+  writer.finish(summarize(r, 10));
+  return out.str();
 }
 
 // The layout of json::dump(1) for {"elements": [...], "summary": {...}} (keys sorted), one
@@ -283,7 +323,7 @@ void CheckJsonWriter::add(const CheckBatch& b) {
   for (std::size_t i = 0; i < b.elements.size(); ++i) {
     text += any_ ? ",\n  " : "\n  ";
     any_ = true;
-    text += indented(element_json(b.elements[i], b.distortion_of(i), b.mu_of(i), b.sj_of(i)).dump(1), "  ");
+    append_element_json(text, b.elements[i], b.distortion_of(i), b.mu_of(i), b.sj_of(i));
   }
   *out_ << text;
 }

@@ -89,6 +89,33 @@ struct StreamedRun {
   std::size_t batches = 0;
 };
 
+// The JSON of one element built field by field with nlohmann (the writer formats it by hand):
+// non-finite doubles are null.
+nlohmann::json element_dom(const ElementCheck& e, const DistortionBounds& d, const QualityBounds& mu,
+                           const QualityBounds& sj) {
+  using nlohmann::json;
+  const auto jnum = [](double x) { return std::isfinite(x) ? json(x) : json(nullptr); };
+  const JacobianBounds& b = e.bounds;
+  json je = {{"tag", e.tag},
+             {"type", e.type->gmsh_id},
+             {"validity", e.analysed ? validity_name(b.validity) : "skipped"}};
+  if (e.analysed) {
+    je["jmin"] = {jnum(b.jmin_lower), jnum(b.jmin_upper)};
+    je["jmax"] = {jnum(b.jmax_lower), jnum(b.jmax_upper)};
+    je["distortion"] = {jnum(d.lower), jnum(d.upper)};
+    je["ratio_lower"] = jnum(e.ratio_lower());
+    je["jmin_over_javg"] = jnum(e.jmin_over_javg());
+    je["subdivisions"] = b.subdivisions;
+    je["stage"] = b.stage;
+    je["exact"] = b.exact;
+    for (const auto& [name, q] : {std::pair{"mu", mu}, std::pair{"sj", sj}})
+      if (!std::isnan(q.lower))
+        je[name] = {{"lower", jnum(q.lower)}, {"upper", jnum(q.upper)}, {"subdivisions", q.subdivisions},
+                    {"tolerance_met", q.tolerance_met}};
+  }
+  return je;
+}
+
 StreamedRun streamed_run(const Mesh& mesh, const CheckOptions& o, const std::string& file) {
   StreamedRun run;
   std::ostringstream json;
@@ -157,6 +184,13 @@ void check_both_modes(const Mesh& mesh, CheckOptions o, const std::string& file)
     EXPECT_EQ(run.csv, check_csv(run.report));
     EXPECT_EQ(run.csv, check_csv(stored));
     EXPECT_EQ(run.json, check_json(run.report));
+    // Each element of the JSON as nlohmann builds it, field by field.
+    const nlohmann::json parsed = nlohmann::json::parse(run.json);
+    ASSERT_EQ(parsed["elements"].size(), run.report.elements.size());
+    for (std::size_t i = 0; i < run.report.elements.size(); ++i)
+      ASSERT_EQ(parsed["elements"][i], element_dom(run.report.elements[i], run.report.distortion_of(i),
+                                                   run.report.mu_of(i), run.report.sj_of(i)))
+          << "element " << i;
     expect_same_fields(run.fields, check_fields(mesh, run.report));
     summaries.push_back(run.summary);
   }
