@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 
 #include <fmt/core.h>
 
@@ -30,31 +31,45 @@ std::string xml_escape(const std::string& s) {
   return out;
 }
 
-/// One appended array: its XML declaration and its bytes.
+/// One appended array: its XML declaration, its size, and how to write its values (streamed
+/// block by block: the connectivity and the other cell arrays of a million hexahedra are
+/// never held in memory, 150 MB less).
 struct Array {
   std::string type, name;
   int components;
-  std::vector<char> bytes;
+  std::uint64_t bytes;
+  std::function<void(OutBuffer&)> write;
+};
 
-  template <class T>
-  static Array of(std::string type, std::string name, int components, const std::vector<T>& values) {
-    Array a{std::move(type), std::move(name), components, {}};
-    a.bytes.resize(values.size() * sizeof(T));
-    if (!values.empty()) std::memcpy(a.bytes.data(), values.data(), a.bytes.size());
-    return a;
+// Values of one fixed-size type through a small staging buffer.
+template <class T>
+class Stream {
+ public:
+  explicit Stream(OutBuffer& o) : o_(o) {}
+  ~Stream() { flush(); }
+  Stream(const Stream&) = delete;
+  Stream& operator=(const Stream&) = delete;
+  void put(T v) {
+    stage_[n_++] = v;
+    if (n_ == kStage) flush();
   }
+  void flush() {
+    if (n_ > 0) o_.bytes_buffered(stage_, n_ * sizeof(T));
+    n_ = 0;
+  }
+
+ private:
+  static constexpr std::size_t kStage = 4096;
+  OutBuffer& o_;
+  T stage_[kStage];
+  std::size_t n_ = 0;
 };
 
 }  // namespace
 
 void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField> fields, const std::string& file) {
   QV_ASSERT(mesh.coords.size() == 3 * mesh.num_nodes(), "coordinates do not match the nodes");
-  std::vector<std::int64_t> connectivity, offsets;
-  std::vector<std::uint8_t> types;
-  std::vector<std::int64_t> element_tags;
-  std::vector<std::int32_t> entity_tags;
-  connectivity.reserve(mesh.num_elements() * 4);
-  offsets.reserve(mesh.num_elements());
+  std::uint64_t cells = 0, corners = 0;
   for (const ElementBlock& b : mesh.blocks) {
     const VtkCell& cell = vtk_cell(*b.type);
     if (!cell.exact && b.size() > 0)
@@ -62,26 +77,56 @@ void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField
                  b.type->gmsh_id, b.type->name, cell.note);
     for (std::size_t e = 0; e < b.size(); ++e) {
       const auto nodes = b.element(e);
-      for (int g : cell.gmsh_node) {
+      for (int g : cell.gmsh_node)
         QV_ASSERT(nodes[static_cast<std::size_t>(g)] < mesh.num_nodes(), "node index out of range");
-        connectivity.push_back(nodes[static_cast<std::size_t>(g)]);
-      }
-      offsets.push_back(static_cast<std::int64_t>(connectivity.size()));
-      types.push_back(static_cast<std::uint8_t>(cell.vtk_type));
-      element_tags.push_back(static_cast<std::int64_t>(b.tags[e]));
-      entity_tags.push_back(b.entity_tag);
     }
+    cells += b.size();
+    corners += b.size() * cell.gmsh_node.size();
   }
+  // Each array walks the blocks in order, one value at a time.
+  const auto per_cell = [&mesh]<class T>(OutBuffer& o, auto value) {
+    Stream<T> s(o);
+    for (const ElementBlock& b : mesh.blocks)
+      for (std::size_t e = 0; e < b.size(); ++e) s.put(static_cast<T>(value(b, e)));
+  };
   std::vector<Array> point_arrays, cell_arrays, cell_data;
-  point_arrays.push_back(Array::of("Float64", "Points", 3, mesh.coords));
-  cell_arrays.push_back(Array::of("Int64", "connectivity", 1, connectivity));
-  cell_arrays.push_back(Array::of("Int64", "offsets", 1, offsets));
-  cell_arrays.push_back(Array::of("UInt8", "types", 1, types));
-  cell_data.push_back(Array::of("Int64", "element_tag", 1, element_tags));
-  cell_data.push_back(Array::of("Int32", "entity_tag", 1, entity_tags));
+  point_arrays.push_back({"Float64", "Points", 3, mesh.coords.size() * sizeof(double), [&](OutBuffer& o) {
+                            o.bytes(mesh.coords.data(), mesh.coords.size() * sizeof(double));
+                          }});
+  cell_arrays.push_back({"Int64", "connectivity", 1, corners * sizeof(std::int64_t), [&](OutBuffer& o) {
+                           Stream<std::int64_t> s(o);
+                           for (const ElementBlock& b : mesh.blocks) {
+                             const VtkCell& cell = vtk_cell(*b.type);
+                             for (std::size_t e = 0; e < b.size(); ++e) {
+                               const auto nodes = b.element(e);
+                               for (int g : cell.gmsh_node) s.put(nodes[static_cast<std::size_t>(g)]);
+                             }
+                           }
+                         }});
+  cell_arrays.push_back({"Int64", "offsets", 1, cells * sizeof(std::int64_t), [&](OutBuffer& o) {
+                           Stream<std::int64_t> s(o);
+                           std::int64_t offset = 0;
+                           for (const ElementBlock& b : mesh.blocks) {
+                             const auto k = static_cast<std::int64_t>(vtk_cell(*b.type).gmsh_node.size());
+                             for (std::size_t e = 0; e < b.size(); ++e) s.put(offset += k);
+                           }
+                         }});
+  cell_arrays.push_back({"UInt8", "types", 1, cells, [&](OutBuffer& o) {
+                           per_cell.template operator()<std::uint8_t>(
+                               o, [](const ElementBlock& b, std::size_t) { return vtk_cell(*b.type).vtk_type; });
+                         }});
+  cell_data.push_back({"Int64", "element_tag", 1, cells * sizeof(std::int64_t), [&](OutBuffer& o) {
+                         per_cell.template operator()<std::int64_t>(
+                             o, [](const ElementBlock& b, std::size_t e) { return b.tags[e]; });
+                       }});
+  cell_data.push_back({"Int32", "entity_tag", 1, cells * sizeof(std::int32_t), [&](OutBuffer& o) {
+                         per_cell.template operator()<std::int32_t>(
+                             o, [](const ElementBlock& b, std::size_t) { return b.entity_tag; });
+                       }});
   for (const ElementField& f : fields) {
     QV_ASSERT(f.values.size() == mesh.num_elements(), "field " << f.name << " has the wrong size");
-    cell_data.push_back(Array::of("Float64", f.name, 1, f.values));
+    cell_data.push_back({"Float64", f.name, 1, f.values.size() * sizeof(double),
+                         [&f](OutBuffer& o) { o.bytes(f.values.data(), f.values.size() * sizeof(double)); }});
   }
 
   OutBuffer o(out);
@@ -89,13 +134,12 @@ void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField
   auto declare = [&](const Array& a) {
     o.text("        <DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\" format=\"appended\" offset=\"{}\"/>\n",
            a.type, xml_escape(a.name), a.components, offset);
-    offset += sizeof(std::uint64_t) + a.bytes.size();
+    offset += sizeof(std::uint64_t) + a.bytes;
   };
   o.text("<?xml version=\"1.0\"?>\n");
   o.text("<VTKFile type=\"UnstructuredGrid\" version=\"2.2\" byte_order=\"{}\" header_type=\"UInt64\">\n",
          std::endian::native == std::endian::little ? "LittleEndian" : "BigEndian");
-  o.text("  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", mesh.num_nodes(),
-         types.size());
+  o.text("  <UnstructuredGrid>\n    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", mesh.num_nodes(), cells);
   o.text("      <Points>\n");
   for (const Array& a : point_arrays) declare(a);
   o.text("      </Points>\n      <Cells>\n");
@@ -105,8 +149,8 @@ void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField
   o.text("      </CellData>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
   for (const auto* group : {&point_arrays, &cell_arrays, &cell_data}) {
     for (const Array& a : *group) {
-      o.raw(static_cast<std::uint64_t>(a.bytes.size()));
-      o.bytes(a.bytes.data(), a.bytes.size());
+      o.raw(a.bytes);
+      a.write(o);
     }
   }
   o.text("\n  </AppendedData>\n</VTKFile>\n");
