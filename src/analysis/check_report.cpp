@@ -73,7 +73,6 @@ void quality_section(std::string& out, const CheckSummary& r, bool sj, std::size
   out += "\n";
 }
 
-// One element's JSON object (check_json's "elements" entries).
 // One element of the JSON "elements" array, in the layout of nlohmann::json::dump(1) nested
 // two levels deep (keys sorted), written straight into `out`: the DOM and its dump took 5 s
 // for a million elements. Non-finite doubles are null, as nlohmann writes them; the others
