@@ -16,6 +16,8 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include <omp.h>
+
 #include "commands.hpp"
 #include "terminal_progress.hpp"
 #include "quadval/atomic_file.hpp"
@@ -33,7 +35,7 @@ struct RecombineCliOptions {
   std::string algo = "blossom", cost = "angle", odd = "split";
   std::string size_field, cross_field_file;
   double cross_field_degrees = 0.0;
-  int smooth = 5, cleanup_passes = 5;
+  int smooth = 5, cleanup_passes = 5, threads = 0;
   bool no_optimize = false, full_quad = false, quiet = false, binary = false;
   bool no_extra_edges = false;
   double extra_edge_cost = 1000.0;
@@ -126,6 +128,9 @@ int run(const RecombineCliOptions& o) {
   options.extra_edge_cost = o.extra_edge_cost;
   options.optimize = !o.no_optimize;
   options.smoothing_passes = o.smooth;
+  // The library's parallel loops (pair costs, smoothing, statistics, look-ahead runs) use
+  // OpenMP's thread count; their results do not depend on it.
+  if (o.threads > 0) omp_set_num_threads(o.threads);
   options.max_cleanup_passes = o.cleanup_passes;
   options.full_quad = o.full_quad;
   std::optional<SizeField> size;
@@ -236,6 +241,10 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
                   "Size field h(x,y,z) (e.g. \"0.1+0.08*sin(3*x)*cos(6*y)\"): weights the "
                   "smoothing and gives the efficiency index tau");
   cmd->add_option("--smooth", o->smooth, "Smoothing passes (0: none)")->capture_default_str();
+  cmd->add_option("--threads", o->threads,
+                  "Threads at most (0: all cores); results do not depend on it")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->add_option("--cleanup-passes", o->cleanup_passes,
                   "Rounds of quad-vertex-merge and doublet collapse (0: none)")
       ->capture_default_str();

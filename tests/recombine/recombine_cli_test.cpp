@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -52,6 +53,24 @@ TEST_F(RecombineCli, RectSinGivesAllQuadMeshAndReport) {
   EXPECT_GT(s.at("eta_min").get<double>(), 0.0);
   EXPECT_FALSE(s.at("tau_percent").is_null());
   EXPECT_FALSE(s.at("times").empty());
+}
+
+// --threads changes the time, never the mesh: smoothing's colour blocks and the other
+// parallel loops give the same bytes on one thread and on two.
+TEST_F(RecombineCli, OneThreadAndTwoWriteTheSameMesh) {
+  const fs::path in = fs::path(QUADVAL_SHARED_DIR) / "data/tri/uniform-10k-a6.msh";
+  if (!fs::exists(in)) GTEST_SKIP() << in << " missing";
+  std::string bytes[2];
+  for (int threads : {1, 2}) {
+    const fs::path out = dir_ / ("t" + std::to_string(threads) + ".msh");
+    const CliRun r = run_cli("recombine " + in.string() + " -o " + out.string() + " -q --threads " +
+                             std::to_string(threads) + " --size-field '0.02+0.01*x'");
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::ifstream f(out, std::ios::binary);
+    bytes[threads - 1].assign(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+  }
+  EXPECT_GT(bytes[0].size(), 100000u);
+  EXPECT_EQ(bytes[0], bytes[1]);
 }
 
 TEST_F(RecombineCli, QuietPrintsNothing) {
