@@ -65,6 +65,14 @@ class Stream {
   std::size_t n_ = 0;
 };
 
+// One value per cell, the blocks in order.
+template <class T, class Value>
+void write_per_cell(OutBuffer& o, const Mesh& mesh, Value value) {
+  Stream<T> s(o);
+  for (const ElementBlock& b : mesh.blocks)
+    for (std::size_t e = 0; e < b.size(); ++e) s.put(static_cast<T>(value(b, e)));
+}
+
 }  // namespace
 
 void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField> fields, const std::string& file) {
@@ -75,20 +83,9 @@ void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField
     if (!cell.exact && b.size() > 0)
       fmt::print(stderr, "quadval: warning: {}: {} elements of type {} ({}) written as {}\n", file, b.size(),
                  b.type->gmsh_id, b.type->name, cell.note);
-    for (std::size_t e = 0; e < b.size(); ++e) {
-      const auto nodes = b.element(e);
-      for (int g : cell.gmsh_node)
-        QV_ASSERT(nodes[static_cast<std::size_t>(g)] < mesh.num_nodes(), "node index out of range");
-    }
     cells += b.size();
     corners += b.size() * cell.gmsh_node.size();
   }
-  // Each array walks the blocks in order, one value at a time.
-  const auto per_cell = [&mesh]<class T>(OutBuffer& o, auto value) {
-    Stream<T> s(o);
-    for (const ElementBlock& b : mesh.blocks)
-      for (std::size_t e = 0; e < b.size(); ++e) s.put(static_cast<T>(value(b, e)));
-  };
   std::vector<Array> point_arrays, cell_arrays, cell_data;
   point_arrays.push_back({"Float64", "Points", 3, mesh.coords.size() * sizeof(double), [&](OutBuffer& o) {
                             o.bytes(mesh.coords.data(), mesh.coords.size() * sizeof(double));
@@ -99,7 +96,12 @@ void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField
                              const VtkCell& cell = vtk_cell(*b.type);
                              for (std::size_t e = 0; e < b.size(); ++e) {
                                const auto nodes = b.element(e);
-                               for (int g : cell.gmsh_node) s.put(nodes[static_cast<std::size_t>(g)]);
+                               for (int g : cell.gmsh_node) {
+                                 const NodeIndex n = nodes[static_cast<std::size_t>(g)];
+                                 // A throw here leaves no file: the writers write to a temporary.
+                                 QV_ASSERT(n < mesh.num_nodes(), "node index out of range");
+                                 s.put(n);
+                               }
                              }
                            }
                          }});
@@ -112,16 +114,16 @@ void write_vtu(const Mesh& mesh, std::ostream& out, std::span<const ElementField
                            }
                          }});
   cell_arrays.push_back({"UInt8", "types", 1, cells, [&](OutBuffer& o) {
-                           per_cell.template operator()<std::uint8_t>(
-                               o, [](const ElementBlock& b, std::size_t) { return vtk_cell(*b.type).vtk_type; });
+                           write_per_cell<std::uint8_t>(
+                               o, mesh, [](const ElementBlock& b, std::size_t) { return vtk_cell(*b.type).vtk_type; });
                          }});
   cell_data.push_back({"Int64", "element_tag", 1, cells * sizeof(std::int64_t), [&](OutBuffer& o) {
-                         per_cell.template operator()<std::int64_t>(
-                             o, [](const ElementBlock& b, std::size_t e) { return b.tags[e]; });
+                         write_per_cell<std::int64_t>(o, mesh,
+                                                      [](const ElementBlock& b, std::size_t e) { return b.tags[e]; });
                        }});
   cell_data.push_back({"Int32", "entity_tag", 1, cells * sizeof(std::int32_t), [&](OutBuffer& o) {
-                         per_cell.template operator()<std::int32_t>(
-                             o, [](const ElementBlock& b, std::size_t) { return b.entity_tag; });
+                         write_per_cell<std::int32_t>(o, mesh,
+                                                      [](const ElementBlock& b, std::size_t) { return b.entity_tag; });
                        }});
   for (const ElementField& f : fields) {
     QV_ASSERT(f.values.size() == mesh.num_elements(), "field " << f.name << " has the wrong size");
