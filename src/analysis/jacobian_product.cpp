@@ -598,7 +598,7 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
   double* range = x + n * 3 * w;
   for (std::size_t l = 0; l < w; ++l) {
     const double* xe = nodes + l * stride;
-    double r[3] = {0, 0, 0};  // locals: stores to x could alias range[], so kept in memory
+    double r[3] = {0, 0, 0};  // in registers: through range[] every store to x would reload it
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t j = 0; j < axes; ++j) {
         const double d = xe[3 * i + j] - xe[j];
