@@ -120,15 +120,18 @@ int run_check(const CheckCliOptions& o) {
   CheckSummary summary;
   const std::function<void(std::size_t)> open_then_check = [&](std::size_t k) {
     if (k == text_outputs.size()) {
-      summary = check_mesh_streamed(mesh, opts, o.input, [&](const CheckBatch& batch) {
-        if (!csv_streams.empty()) {
-          std::string rows;
-          append_check_csv_rows(rows, batch);
-          for (std::ostream* os : csv_streams) *os << rows;
-        }
-        for (CheckJsonWriter& w : json_writers) w.add(batch);
-        if (fields) fields->add(batch);
-      });
+      CheckSink sink;  // none without outputs: then the analysis keeps no per-element records
+      if (!csv_streams.empty() || !json_writers.empty() || fields)
+        sink = [&](const CheckBatch& batch) {
+          if (!csv_streams.empty()) {
+            std::string rows;
+            append_check_csv_rows(rows, batch);
+            for (std::ostream* os : csv_streams) *os << rows;
+          }
+          for (CheckJsonWriter& w : json_writers) w.add(batch);
+          if (fields) fields->add(batch);
+        };
+      summary = check_mesh_streamed(mesh, opts, o.input, sink);
       for (CheckJsonWriter& w : json_writers) w.finish(summary);
       return;
     }

@@ -222,9 +222,10 @@ inline constexpr std::size_t kCheckBatch = 16384;
 
 /// Analyses every element of the mesh's highest dimension, keeping only the summary: the
 /// elements go in batches of kCheckBatch, each handed to `sink` (when given) from the
-/// calling thread, in element order, once done, then dropped. Memory beyond the mesh: one
-/// batch of results and the bounded worst lists, whatever the mesh size. Results (and the
-/// batches' contents) do not depend on the thread count.
+/// calling thread, in element order, once done, then dropped. Memory beyond the mesh: a few
+/// batches of results and the bounded worst lists, whatever the mesh size; with no sink and
+/// no mu or scaled Jacobian, only a chunk of results per thread. Results (and the batches'
+/// contents) do not depend on the thread count.
 /// @throws InputError (file = `file`) for non-finite node coordinates; whatever `sink` throws
 CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options,
                                  const std::string& file = "", const CheckSink& sink = {});

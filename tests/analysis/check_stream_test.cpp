@@ -179,6 +179,8 @@ void check_both_modes(const Mesh& mesh, CheckOptions o, const std::string& file)
     // ... and of check_mesh, which stores them all.
     const CheckReport stored = check_mesh(mesh, o, file);
     expect_same_summary(run.summary, summarize(stored, o.worst));
+    // ... and of a run with no sink, which keeps no per-element records.
+    expect_same_summary(run.summary, check_mesh_streamed(mesh, o, file, {}));
     EXPECT_EQ(format_check_summary(run.summary, o.worst), format_check_summary(run.report, o.worst));
     // Files written batch by batch are the stored report's, byte for byte.
     EXPECT_EQ(run.csv, check_csv(run.report));
