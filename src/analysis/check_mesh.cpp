@@ -14,6 +14,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <span>
 #include <thread>
 #include <type_traits>
@@ -28,6 +29,7 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/stage_clock.hpp"
+#include "analysis/worker_threads.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
 #include "quadval/mu_bounds.hpp"
@@ -248,8 +250,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     }
   }
   work *= weight;
-  // Threads only for work worth them: each extra one costs its start (0.1-0.15 ms in a
-  // fresh process, measured) and the closing barrier, and more when the cores are busy
+  // Threads only for work worth them: each extra one costs its start (about 0.1 ms,
+  // worker_threads.hpp) and the closing join, and more when the cores are busy
   // (results do not depend on it), so one thread per kWorkPerThread units (about 1 ms),
   // and never more than chunks.
   constexpr double kWorkPerThread = 1e6;
@@ -267,12 +269,13 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   std::atomic<std::size_t> flushed{0};     // batches handed out so far
   const auto remaining = std::make_unique<std::atomic<std::size_t>[]>(num_batches);  // chunks left
   for (std::size_t b = 0; b < num_batches; ++b) remaining[b] = batches[b + 1] - batches[b];
+  std::mutex failure_mutex;
   const auto fail = [&](std::exception_ptr e) {
-#pragma omp critical(check_failure)
+    const std::lock_guard<std::mutex> lock(failure_mutex);
     if (!failure) failure = e;
     failed = true;
   };
-  // On the calling thread (OpenMP's master): hands out every finished batch, in order.
+  // On the calling thread (thread 0): hands out every finished batch, in order.
   const auto flush_ready = [&] {
     for (std::size_t b = flushed.load(std::memory_order_relaxed);
          b < num_batches && !failed && remaining[b].load(std::memory_order_acquire) == 0; ++b) {
@@ -304,12 +307,11 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   const auto pause = [] { std::this_thread::sleep_for(std::chrono::microseconds(20)); };
 
   const double setup_seconds = now_seconds() - t0;
-#pragma omp parallel num_threads(threads)
-  {
-    const bool master = omp_get_thread_num() == 0;
+  run_on_threads(threads, [&](int thread) {
+    const bool master = thread == 0;
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
-    ThreadStats& st = stats[static_cast<std::size_t>(omp_get_thread_num())];
+    ThreadStats& st = stats[static_cast<std::size_t>(thread)];
     std::vector<double> nodes, errors, coeffs, soa;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
@@ -476,7 +478,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
           if (!sj.empty()) mine.sj = sj;
           add_elements(st.summary, mine, ch.out, ch.out + ch.count);
           const std::size_t d = done.fetch_add(ch.count) + ch.count;
-          if (options.progress && omp_get_thread_num() == 0) options.progress(d, total);
+          if (options.progress && master) options.progress(d, total);
         } catch (...) {
           fail(std::current_exception());
         }
@@ -490,7 +492,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
         flush_ready();
         if (flushed.load(std::memory_order_relaxed) < num_batches) pause();
       }
-  }
+  });
   if (failure) std::rethrow_exception(failure);
 
   const double seconds_per_tick = tick_rate.seconds_per_tick();

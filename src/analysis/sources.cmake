@@ -16,6 +16,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/mu_control_bound.cpp
   src/analysis/mu_bounds.cpp
   src/analysis/check_mesh.cpp
+  src/analysis/worker_threads.cpp
   src/analysis/check_report.cpp
   src/analysis/check_summary.cpp
 )

@@ -19,6 +19,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/linear_fast_path_test.cpp
   analysis/jacobian_batch_test.cpp
   analysis/check_threads_test.cpp
+  analysis/worker_threads_test.cpp
   analysis/check_stream_test.cpp
   analysis/distortion_refine_test.cpp
   analysis/product_tables_test.cpp
