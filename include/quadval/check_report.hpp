@@ -217,7 +217,7 @@ struct CheckBatch {
 };
 using CheckSink = std::function<void(const CheckBatch&)>;
 
-/// Elements per batch of check_mesh_streamed (a multiple of its chunks of 256).
+/// Elements per batch of check_mesh_streamed (a multiple of its chunks, of 64 or 256).
 inline constexpr std::size_t kCheckBatch = 16384;
 
 /// Analyses every element of the mesh's highest dimension, keeping only the summary: the

@@ -59,17 +59,17 @@ TEST(CheckThreads, LargeWorkUsesThreadsWithIdenticalAnswers) {
 
 TEST(CheckThreads, MeasuringCountsAsMoreWork) {
   // One thread per 1e6 units (node x J coefficient, weighed 50 times when measuring),
-  // capped by the chunks of 256 elements and by the threads requested. 300 tetrahedra of
-  // order 2 (two chunks): 300 x 10 x 20 = 6e4 units for validity, one thread; 3e6
-  // measuring, capped by the two chunks.
-  const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 2, true), 300, 3);
+  // capped by the chunks (64 curved elements each) and by the threads requested. 128
+  // tetrahedra of order 3 (two chunks): 128 x 20 x 84 = 2.15e5 units for validity, one
+  // thread; 1.08e7 measuring, capped by the two chunks.
+  const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 128, 3);
   CheckOptions o;
   o.threads = 8;
   o.measure = CheckMeasure::validity;
   EXPECT_EQ(check_mesh(small, o).threads, 1);
   o.measure = CheckMeasure::jacobian;
   EXPECT_EQ(check_mesh(small, o).threads, 2);
-  // 3000 tetrahedra of order 3 (12 chunks): 3000 x 20 x 84 = 5.04e6 units for validity,
+  // 3000 tetrahedra of order 3 (47 chunks): 3000 x 20 x 84 = 5.04e6 units for validity,
   // six threads; 2.5e8 measuring: capped by the 8 requested.
   const Mesh big = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 3000, 4);
   o.measure = CheckMeasure::validity;
