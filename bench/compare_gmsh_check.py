@@ -114,7 +114,7 @@ def main():
                 g = json.load(open(gjson))
                 gruns.append((g["t_plugin_run_s"], (g["n_invalid_ratio_le_0"], mem_g)))
             tg, (inv_g, mem_g) = median_run(gruns)
-            print("%-36s %9d %8d %8d %10.4f %10.4f %12.3g %12.3g %8.1f %9.0f %9.0f" % (
+            print("%-36s %9d %8d %8d %10.3g %10.3g %12.3g %12.3g %8.1f %9.0f %9.0f" % (
                 os.path.basename(m)[:36], n, inv_q, inv_g, tq, tg, n / tq, n / tg, tg / tq, mem_q, mem_g))
 
 
@@ -178,7 +178,7 @@ def quality(a, meshes, tool):
                     g = json.load(open(gjson))
                     gruns.append((g["t_plugin_run_s"], g.get(gkey, float("nan"))))
                 tg, worst_g = median_run(gruns)
-                print("%-36s %-16s %9d %10.4f %10.4f %12.3g %12.3g %8.1f %11.4g %11.4g" % (
+                print("%-36s %-16s %9d %10.3g %10.3g %12.3g %12.3g %8.1f %11.4g %11.4g" % (
                     os.path.basename(m)[:36], "%s/%s" % ("mu" if qkey == "mu" else "sj", gmeasures[1:]), n, tq, tg,
                     n / tq, n / tg, tg / tq, worst_q, worst_g))
 
