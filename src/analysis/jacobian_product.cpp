@@ -18,11 +18,13 @@
 // same sums in the same order as one element alone (no FMA: -ffp-contract=off), so the
 // model above, which allows any summation order, holds unchanged. Its loops over the lanes
 // carry `omp simd`: without it GCC 12 unrolled them into scalar code (measured: 2x slower
-// on order-4 triangles, 2.9x on order-2 hexahedra).
+// on order-4 triangles, 2.9x on order-2 hexahedra). The products' accumulators are
+// Lanes<W> vectors: as arrays, GCC 12 kept them on the stack, a store and a reload per term.
 #include "analysis/jacobian_product.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <map>
 #include <tuple>
@@ -43,6 +45,22 @@ namespace {
 
 using MultiIndex = std::array<int, 4>;
 constexpr double kUnit = 0x1p-53;
+
+// W doubles, one per lane, held in one register (a GCC vector: each operation is the
+// scalar one on every lane, so lane l computes what an element computed alone does).
+template <int W>
+struct LaneVector {
+  typedef double Type __attribute__((vector_size(8 * W)));
+};
+template <int W>
+using Lanes = typename LaneVector<W>::Type;
+
+template <int W>
+Lanes<W> load_lanes(const double* p) {
+  Lanes<W> v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
 
 
 int index_of(const std::vector<MultiIndex>& list, const MultiIndex& a) {
@@ -598,14 +616,23 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
   double* range = x + n * 3 * w;
   for (std::size_t l = 0; l < w; ++l) {
     const double* xe = nodes + l * stride;
-    double r[3] = {0, 0, 0};  // in registers: through range[] every store to x would reload it
-    for (std::size_t i = 0; i < n; ++i)
-      for (std::size_t j = 0; j < axes; ++j) {
-        const double d = xe[3 * i + j] - xe[j];
-        x[(i * 3 + j) * w + l] = d;
-        r[j] = std::max(r[j], std::abs(d));
+    // Three scalars, not an array: GCC 12 kept an array of ranges on the stack.
+    double r0 = 0, r1 = 0, r2 = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double d0 = xe[3 * i] - xe[0], d1 = xe[3 * i + 1] - xe[1];
+      x[(i * 3) * w + l] = d0;
+      x[(i * 3 + 1) * w + l] = d1;
+      r0 = std::max(r0, std::abs(d0));
+      r1 = std::max(r1, std::abs(d1));
+      if (axes == 3) {
+        const double d2 = xe[3 * i + 2] - xe[2];
+        x[(i * 3 + 2) * w + l] = d2;
+        r2 = std::max(r2, std::abs(d2));
       }
-    for (std::size_t j = 0; j < 3; ++j) range[j * w + l] = r[j];
+    }
+    range[l] = r0;
+    range[w + l] = r1;
+    range[2 * w + l] = r2;
   }
 
   // Derivative control points, scaled: d_ckj = sum_i G^_ki x_ij over the nonzero G^_ki in
@@ -646,8 +673,10 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
   }
 
   // Products, then J_gamma = J^_gamma / mult(gamma), written element-major.
-  const auto store = [&](std::size_t k, const double* acc) {
-    for (std::size_t l = 0; l < w; ++l) coeffs[l * S + k] = acc[l] * inv_mult_[k];
+  using V = Lanes<W>;
+  const auto store = [&](std::size_t k, const V& acc) {
+    const V scaled = acc * inv_mult_[k];
+    for (std::size_t l = 0; l < w; ++l) coeffs[l * S + k] = scaled[l];
   };
   double* refs = next;  // 1D, 2D: the reference vector of each lane, [j][lane]
   if (dim_ < 3)
@@ -660,67 +689,60 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
     const double* d2 = deriv[2];
     double* cr = next;
     for (std::size_t m = 0; m + 1 < cross_gather_.first.size(); ++m) {
-      double a0[W] = {}, a1[W] = {}, a2[W] = {};
+      V a0{}, a1{}, a2{};
       for (int t = cross_gather_.first[m]; t < cross_gather_.first[m + 1]; ++t) {
         const auto& term = cross_gather_.terms[static_cast<std::size_t>(t)];
         const double* b = d1 + static_cast<std::size_t>(term[0]) * 3 * w;
         const double* c = d2 + static_cast<std::size_t>(term[1]) * 3 * w;
-        #pragma omp simd
-        for (std::size_t l = 0; l < w; ++l) {
-          a0[l] += b[w + l] * c[2 * w + l] - b[2 * w + l] * c[w + l];
-          a1[l] += b[2 * w + l] * c[l] - b[l] * c[2 * w + l];
-          a2[l] += b[l] * c[w + l] - b[w + l] * c[l];
-        }
+        const V b0 = load_lanes<W>(b), b1 = load_lanes<W>(b + w), b2 = load_lanes<W>(b + 2 * w);
+        const V c0 = load_lanes<W>(c), c1 = load_lanes<W>(c + w), c2 = load_lanes<W>(c + 2 * w);
+        a0 += b1 * c2 - b2 * c1;
+        a1 += b2 * c0 - b0 * c2;
+        a2 += b0 * c1 - b1 * c0;
       }
-      for (std::size_t l = 0; l < w; ++l) {
-        cr[(m * 3) * w + l] = a0[l];
-        cr[(m * 3 + 1) * w + l] = a1[l];
-        cr[(m * 3 + 2) * w + l] = a2[l];
-      }
+      std::memcpy(cr + (m * 3) * w, &a0, sizeof a0);
+      std::memcpy(cr + (m * 3 + 1) * w, &a1, sizeof a1);
+      std::memcpy(cr + (m * 3 + 2) * w, &a2, sizeof a2);
     }
     const double* d0 = deriv[0];
     for (std::size_t k = 0; k < S; ++k) {
-      double acc[W] = {};
+      V acc{};
       for (int t = dot_gather_.first[k]; t < dot_gather_.first[k + 1]; ++t) {
         const auto& term = dot_gather_.terms[static_cast<std::size_t>(t)];
         const double* a = d0 + static_cast<std::size_t>(term[0]) * 3 * w;
         const double* m = cr + static_cast<std::size_t>(term[1]) * 3 * w;
-        #pragma omp simd
-        for (std::size_t l = 0; l < w; ++l)
-          acc[l] += a[l] * m[l] + a[w + l] * m[w + l] + a[2 * w + l] * m[2 * w + l];
+        acc += load_lanes<W>(a) * load_lanes<W>(m) + load_lanes<W>(a + w) * load_lanes<W>(m + w) +
+               load_lanes<W>(a + 2 * w) * load_lanes<W>(m + 2 * w);
       }
       store(k, acc);
     }
   } else if (dim_ == 2) {
     const double* d0 = deriv[0];
     const double* d1 = deriv[1];
+    const V n0 = load_lanes<W>(refs), n1 = load_lanes<W>(refs + w), n2 = load_lanes<W>(refs + 2 * w);
     for (std::size_t k = 0; k < S; ++k) {
-      double acc[W] = {};
+      V acc{};
       for (int t = cross_gather_.first[k]; t < cross_gather_.first[k + 1]; ++t) {
         const auto& term = cross_gather_.terms[static_cast<std::size_t>(t)];
         const double* a = d0 + static_cast<std::size_t>(term[0]) * 3 * w;
         const double* b = d1 + static_cast<std::size_t>(term[1]) * 3 * w;
+        const V a0 = load_lanes<W>(a), a1 = load_lanes<W>(a + w);
+        const V b0 = load_lanes<W>(b), b1 = load_lanes<W>(b + w);
         if (planar) {
-          #pragma omp simd
-          for (std::size_t l = 0; l < w; ++l) acc[l] += a[l] * b[w + l] - a[w + l] * b[l];
+          acc += a0 * b1 - a1 * b0;
         } else {
-          #pragma omp simd
-          for (std::size_t l = 0; l < w; ++l)
-            acc[l] += refs[l] * (a[w + l] * b[2 * w + l] - a[2 * w + l] * b[w + l]) +
-                      refs[w + l] * (a[2 * w + l] * b[l] - a[l] * b[2 * w + l]) +
-                      refs[2 * w + l] * (a[l] * b[w + l] - a[w + l] * b[l]);
+          const V a2 = load_lanes<W>(a + 2 * w), b2 = load_lanes<W>(b + 2 * w);
+          acc += n0 * (a1 * b2 - a2 * b1) + n1 * (a2 * b0 - a0 * b2) + n2 * (a0 * b1 - a1 * b0);
         }
       }
       store(k, acc);
     }
   } else {
     const double* d0 = deriv[0];
+    const V n0 = load_lanes<W>(refs), n1 = load_lanes<W>(refs + w), n2 = load_lanes<W>(refs + 2 * w);
     for (std::size_t k = 0; k < S; ++k) {
       const double* a = d0 + k * 3 * w;
-      double acc[W];
-      for (std::size_t l = 0; l < w; ++l)
-        acc[l] = refs[l] * a[l] + refs[w + l] * a[w + l] + refs[2 * w + l] * a[2 * w + l];
-      store(k, acc);
+      store(k, n0 * load_lanes<W>(a) + n1 * load_lanes<W>(a + w) + n2 * load_lanes<W>(a + 2 * w));
     }
   }
 
