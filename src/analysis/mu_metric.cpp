@@ -497,19 +497,26 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err,
       if (std::find(seen->begin(), seen->end(), key) != seen->end()) continue;
       seen->push_back(key);
     }
-    if (dim == 2) {
-      Eigen::Matrix<double, 3, 2> wm;
-      for (int j = 0; j < 2; ++j)
-        for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c, k);
-      best = std::min(best, corner_upper<2>(wm, err));
-    } else {
-      Eigen::Matrix<double, 3, 3> wm;
-      for (int j = 0; j < 3; ++j)
-        for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c, k);
-      best = std::min(best, corner_upper<3>(wm, err));
-    }
+    best = std::min(best, corner_ratio_upper_at(space, w, err, k));
   }
   return best;
+}
+
+double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k) {
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  const auto at = [&](int j, int c) {
+    return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + static_cast<std::size_t>(k)];
+  };
+  if (space.dim() == 2) {
+    Eigen::Matrix<double, 3, 2> wm;
+    for (int j = 0; j < 2; ++j)
+      for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
+    return corner_upper<2>(wm, err);
+  }
+  Eigen::Matrix<double, 3, 3> wm;
+  for (int j = 0; j < 3; ++j)
+    for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
+  return corner_upper<3>(wm, err);
 }
 
 }  // namespace quadval
