@@ -60,12 +60,19 @@ double element_w(const MuSpace& space, std::span<const double> x, double* w) {
     double xc[3][3] = {};
     for (int c = 0; c < dim; ++c) {
       const double* row = space.derivative(c).data() + k * static_cast<std::size_t>(n);
+      // Sums in scalars: in xc[c][a] GCC 12 stored and reloaded them at every term.
+      double s0 = 0, s1 = 0, s2 = 0;
       for (int i = 0; i < n; ++i) {
         const double g = row[i];
         if (g == 0) continue;
-        for (int a = 0; a < 3; ++a)
-          xc[c][a] += g * (x[static_cast<std::size_t>(3 * i + a)] - x[static_cast<std::size_t>(a)]);
+        const double* xi = x.data() + 3 * static_cast<std::size_t>(i);
+        s0 += g * (xi[0] - x[0]);
+        s1 += g * (xi[1] - x[1]);
+        s2 += g * (xi[2] - x[2]);
       }
+      xc[c][0] = s0;
+      xc[c][1] = s1;
+      xc[c][2] = s2;
     }
     for (int j = 0; j < dim; ++j)
       for (int a = 0; a < 3; ++a) {
