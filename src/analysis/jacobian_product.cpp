@@ -746,38 +746,45 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
     }
   }
 
-  // Error bounds (model at the top of this file).
+  // Error bounds (model at the top of this file), all lanes at once: each lane performs
+  // the operations, in the order, of an element alone.
   const double eps_d = 4 * kUnit + rounding_gamma(static_cast<int>(n));
   static constexpr int kPerm[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {1, 0, 2}, {2, 1, 0}};
-  for (std::size_t l = 0; l < w; ++l) {
-    double hat[3][3] = {}, delta[3][3] = {};
-    for (int c = 0; c < dim_; ++c)
-      for (std::size_t j = 0; j < 3; ++j) {
-        delta[c][j] = eps_d * map.row_sum[static_cast<std::size_t>(c)] * range[j * w + l] * (1 + 1e-10);
-        hat[c][j] = big[c][j][l] * (1 + 4 * kUnit) + delta[c][j];
-      }
-    double pert = 0, mag = 0;
-    if (dim_ == 3) {
+  V hat[3][3] = {}, delta[3][3] = {};
+  for (int c = 0; c < dim_; ++c)
+    for (std::size_t j = 0; j < 3; ++j) {
+      const auto cs = static_cast<std::size_t>(c);
+      delta[c][j] = eps_d * map.row_sum[cs] * load_lanes<W>(range + j * w) * (1 + 1e-10);
+      hat[c][j] = load_lanes<W>(big[c][j]) * (1 + 4 * kUnit) + delta[c][j];
+    }
+  V pert{}, mag{};
+  if (dim_ == 3) {
+    for (const auto& pm : kPerm) {
+      const V a = hat[0][pm[0]], b = hat[1][pm[1]], c = hat[2][pm[2]];
+      pert += delta[0][pm[0]] * b * c + a * delta[1][pm[1]] * c + a * b * delta[2][pm[2]];
+      mag += a * b * c;
+    }
+  } else {
+    double abs_refs[3][W];
+    for (std::size_t j = 0; j < 3; ++j)
+      for (std::size_t l = 0; l < w; ++l) abs_refs[j][l] = std::abs(refs[j * w + l]);
+    if (dim_ == 2) {
       for (const auto& pm : kPerm) {
-        const double a = hat[0][pm[0]], b = hat[1][pm[1]], c = hat[2][pm[2]];
-        pert += delta[0][pm[0]] * b * c + a * delta[1][pm[1]] * c + a * b * delta[2][pm[2]];
-        mag += a * b * c;
-      }
-    } else if (dim_ == 2) {
-      for (const auto& pm : kPerm) {
-        const double r = std::abs(refs[static_cast<std::size_t>(pm[0]) * w + l]);
-        const double a = hat[0][pm[1]], b = hat[1][pm[2]];
+        const V r = load_lanes<W>(abs_refs[pm[0]]);
+        const V a = hat[0][pm[1]], b = hat[1][pm[2]];
         pert += r * (delta[0][pm[1]] * b + a * delta[1][pm[2]]);
         mag += r * a * b;
       }
     } else {
       for (std::size_t j = 0; j < 3; ++j) {
-        pert += std::abs(refs[j * w + l]) * delta[0][j];
-        mag += std::abs(refs[j * w + l]) * hat[0][j];
+        const V r = load_lanes<W>(abs_refs[j]);
+        pert += r * delta[0][j];
+        mag += r * hat[0][j];
       }
     }
-    errors[l] = (pert + rounding_ * mag) * 1.01;
   }
+  const V err = (pert + rounding_ * mag) * 1.01;
+  std::memcpy(errors, &err, sizeof err);
 }
 
 void JacobianProduct::coefficients(SampleMap which, const double* nodes, std::size_t count,
