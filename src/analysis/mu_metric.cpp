@@ -485,11 +485,6 @@ void remember_corners(const MuSpace& space, const double* w, std::vector<std::ar
 
 double corner_ratio_upper(const MuSpace& space, const double* w, double err,
                           std::vector<std::array<double, 9>>* seen) {
-  const int dim = space.dim();
-  const auto ws = static_cast<std::size_t>(space.w_size());
-  const auto at = [&](int j, int c, int k) {
-    return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + static_cast<std::size_t>(k)];
-  };
   double best = 1;
   for (const int k : space.w_basis().vertex_indices()) {
     if (seen) {
