@@ -62,7 +62,6 @@ Lanes<W> load_lanes(const double* p) {
   return v;
 }
 
-
 int index_of(const std::vector<MultiIndex>& list, const MultiIndex& a) {
   const auto it = std::find(list.begin(), list.end(), a);
   QV_ASSERT(it != list.end(), "multi-index outside the space");
