@@ -161,7 +161,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // values agree to 1e-9 relative. Then one corner's upper bound serves for all (they
   // differ by no more than that; the others cost an eigen solve each, a quarter of mu's
   // time on tets_h0.8_o2), and the closed form of mu_constant.hpp settles the element
-  // without products when the gap is met.
+  // without products when the gap is met; its eigenvectors serve the corner's bound too.
   double delta = 0;
   bool constant = false;
   if (mu_constant_path_enabled()) {
@@ -170,20 +170,25 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
     for (std::size_t i = 0; i < block; ++i) wmax = std::max(wmax, std::abs(pool[i]));
     constant = delta <= 1e-9 * wmax;
   }
-  double r_upper = constant ? corner_ratio_upper_at(space, pool.data(), err0, basis.vertex_indices()[0])
-                            : corner_ratio_upper(space, pool.data(), err0);
+  const int corner = basis.vertex_indices()[0];
   if (validity != Validity::valid) {
-    out.upper = sqrt_up(r_upper);
+    out.upper = sqrt_up(constant ? corner_ratio_upper_at(space, pool.data(), err0, corner)
+                                 : corner_ratio_upper(space, pool.data(), err0));
     out.tolerance_met = out.upper <= options.abs_tol;
     return out;
   }
+  double r_upper = 1;
   if (constant) {
-    out.lower = sqrt_down(constant_ratio_lower(space, pool.data(), delta));
+    double eigenvectors[9];
+    out.lower = sqrt_down(constant_ratio_lower(space, pool.data(), delta, eigenvectors));
+    r_upper = corner_ratio_upper_at(space, pool.data(), err0, corner, eigenvectors);
     out.upper = sqrt_up(r_upper);
     if (out.upper - out.lower <= options.abs_tol) {
       out.tolerance_met = true;
       return out;
     }
+  } else {
+    r_upper = corner_ratio_upper(space, pool.data(), err0);
   }
 
   const auto tol_r = [&] {

@@ -19,7 +19,7 @@ thread_local bool use_constant_path = true;
 double margin() { return rounding_gamma(16); }
 
 template <int D>
-double ratio_lower(const Eigen::Matrix<double, 3, D>& w, double delta) {
+double ratio_lower(const Eigen::Matrix<double, 3, D>& w, double delta, double* eigenvectors) {
   const Eigen::Matrix<double, D, D> m = w.transpose() * w;
   if (!m.allFinite()) return 0;
   // Closed-form eigenvectors (Eigen's iterative solver took a quarter of mu's time on
@@ -27,6 +27,10 @@ double ratio_lower(const Eigen::Matrix<double, 3, D>& w, double delta) {
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig;
   eig.computeDirect(m);
   const Eigen::Matrix<double, D, D>& v = eig.eigenvectors();
+  if (eigenvectors != nullptr) {
+    Eigen::Map<Eigen::Matrix<double, D, D>> out(eigenvectors);
+    out = v;
+  }
   if (!v.allFinite()) return 0;
   const double g = margin();
   // eps >= max_i sum_j |(V^T V - I)_ij|: entry errors gamma * sum_k |V_ki V_kj|.
@@ -104,19 +108,19 @@ double constant_w_radius(const MuSpace& space, const double* w, double err) {
   return next_up(err + dev);
 }
 
-double constant_ratio_lower(const MuSpace& space, const double* w, double delta) {
+double constant_ratio_lower(const MuSpace& space, const double* w, double delta, double* eigenvectors) {
   const auto ws = static_cast<std::size_t>(space.w_size());
   const auto at = [&](int j, int c) { return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws]; };
   if (space.dim() == 2) {
     Eigen::Matrix<double, 3, 2> wm;
     for (int j = 0; j < 2; ++j)
       for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-    return ratio_lower<2>(wm, delta);
+    return ratio_lower<2>(wm, delta, eigenvectors);
   }
   Eigen::Matrix<double, 3, 3> wm;
   for (int j = 0; j < 3; ++j)
     for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-  return ratio_lower<3>(wm, delta);
+  return ratio_lower<3>(wm, delta, eigenvectors);
 }
 
 }  // namespace quadval

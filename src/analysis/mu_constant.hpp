@@ -30,6 +30,8 @@ double constant_w_radius(const MuSpace& space, const double* w, double err);
 /// bound of |V^T V - I|: lambda_min(M) >= lambda_min(B) / (1 + eps) and
 /// lambda_max(M) <= lambda_max(B) / (1 - eps). Every operation's rounding is covered
 /// (outward rounding and gamma_k margins).
-double constant_ratio_lower(const MuSpace& space, const double* w, double delta);
+/// @param eigenvectors  optional out: the approximate eigenvectors V used (dim x dim,
+///                      column-major, eigenvalues ascending), for the corners' upper bound
+double constant_ratio_lower(const MuSpace& space, const double* w, double delta, double* eigenvectors = nullptr);
 
 }  // namespace quadval

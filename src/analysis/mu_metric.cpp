@@ -425,16 +425,23 @@ bool MuMetric::certify_3d(double r) {
 
 namespace {
 
-// Upper bound of R at one corner: W (3 x D, fixed size: no allocation per corner).
+// Upper bound of R at one corner: W (3 x D, fixed size: no allocation per corner), with
+// the approximate eigenvectors `given` (D x D, column-major, ascending) or its own.
 template <int D>
-double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err) {
-  const Eigen::Matrix<double, D, D> m = wm.transpose() * wm;
-  if (!m.allFinite()) return 1;
+double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err, const double* given) {
   // Closed-form eigenvectors: any v gives a valid Rayleigh bound, accuracy only matters
   // for tightness (the quotient's error is quadratic in v's).
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, D, D>> eig;
-  eig.computeDirect(m);
-  if (!eig.eigenvectors().allFinite()) return 1;
+  Eigen::Matrix<double, D, D> vectors;
+  if (given != nullptr) {
+    vectors = Eigen::Map<const Eigen::Matrix<double, D, D>>(given);
+  } else {
+    const Eigen::Matrix<double, D, D> m = wm.transpose() * wm;
+    if (!m.allFinite()) return 1;
+    eig.computeDirect(m);
+    vectors = eig.eigenvectors();
+  }
+  if (!vectors.allFinite() || !wm.allFinite()) return 1;
   // Rayleigh quotient |W v|^2 / |v|^2, enclosed: y_c = sum_j w_cj v_j within
   // err sum|v| + gamma_4 sum |w_cj v_j| (+1e-12 relative for the bound's own rounding).
   const auto rayleigh = [&](const Eigen::Matrix<double, D, 1>& v, bool upper) {
@@ -457,8 +464,8 @@ double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err) {
     const double g = rounding_gamma(6) * kSlack;
     return upper ? y2 * (1 + g) / (v2 * (1 - g)) * (1 + g) : y2 * (1 - g) / (v2 * (1 + g)) * (1 - g);
   };
-  const double lmin_hi = rayleigh(eig.eigenvectors().col(0), true);
-  const double lmax_lo = rayleigh(eig.eigenvectors().col(D - 1), false);
+  const double lmin_hi = rayleigh(vectors.col(0), true);
+  const double lmax_lo = rayleigh(vectors.col(D - 1), false);
   if (!(lmax_lo > 0) || !std::isfinite(lmin_hi)) return 1;
   return next_up(lmin_hi / lmax_lo);
 }
@@ -497,7 +504,8 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err,
   return best;
 }
 
-double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k) {
+double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k,
+                             const double* eigenvectors) {
   const auto ws = static_cast<std::size_t>(space.w_size());
   const auto at = [&](int j, int c) {
     return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + static_cast<std::size_t>(k)];
@@ -506,12 +514,12 @@ double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, 
     Eigen::Matrix<double, 3, 2> wm;
     for (int j = 0; j < 2; ++j)
       for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-    return corner_upper<2>(wm, err);
+    return corner_upper<2>(wm, err, eigenvectors);
   }
   Eigen::Matrix<double, 3, 3> wm;
   for (int j = 0; j < 3; ++j)
     for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-  return corner_upper<3>(wm, err);
+  return corner_upper<3>(wm, err, eigenvectors);
 }
 
 }  // namespace quadval

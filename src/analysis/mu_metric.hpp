@@ -102,7 +102,11 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err,
                           std::vector<std::array<double, 9>>* seen = nullptr);
 /// The same bound at one control point k of W (a corner: a value of R at a point of the
 /// subdomain, so an upper bound of its minimum on its own).
-double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k);
+/// @param eigenvectors  optional: approximate eigenvectors of the corner's metric (dim x dim,
+///                      column-major, eigenvalues ascending) to use instead of solving for
+///                      them; any vectors give a true bound, only its tightness depends on them
+double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k,
+                             const double* eigenvectors = nullptr);
 /// Appends the W values of the subdomain's corners to `seen` (corner_ratio_upper's layout).
 void remember_corners(const MuSpace& space, const double* w, std::vector<std::array<double, 9>>& seen);
 
