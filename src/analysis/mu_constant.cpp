@@ -1,5 +1,6 @@
 // Closed-form bounds of mu for constant W (see mu_constant.hpp for the method).
 #include "analysis/mu_constant.hpp"
+#include "analysis/mu_w_matrix.hpp"
 
 #include <Eigen/Dense>
 
@@ -109,18 +110,8 @@ double constant_w_radius(const MuSpace& space, const double* w, double err) {
 }
 
 double constant_ratio_lower(const MuSpace& space, const double* w, double delta, double* eigenvectors) {
-  const auto ws = static_cast<std::size_t>(space.w_size());
-  const auto at = [&](int j, int c) { return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws]; };
-  if (space.dim() == 2) {
-    Eigen::Matrix<double, 3, 2> wm;
-    for (int j = 0; j < 2; ++j)
-      for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-    return ratio_lower<2>(wm, delta, eigenvectors);
-  }
-  Eigen::Matrix<double, 3, 3> wm;
-  for (int j = 0; j < 3; ++j)
-    for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-  return ratio_lower<3>(wm, delta, eigenvectors);
+  if (space.dim() == 2) return ratio_lower<2>(w_at<2>(space, w, 0), delta, eigenvectors);
+  return ratio_lower<3>(w_at<3>(space, w, 0), delta, eigenvectors);
 }
 
 }  // namespace quadval

@@ -7,6 +7,7 @@
 // 1/3 rounded to double). Error bounds are computed in double and enlarged by 1e-12
 // relative, which covers their own rounding.
 #include "analysis/mu_metric.hpp"
+#include "analysis/mu_w_matrix.hpp"
 
 #include <Eigen/Dense>
 
@@ -506,20 +507,8 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err,
 
 double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k,
                              const double* eigenvectors) {
-  const auto ws = static_cast<std::size_t>(space.w_size());
-  const auto at = [&](int j, int c) {
-    return w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + static_cast<std::size_t>(k)];
-  };
-  if (space.dim() == 2) {
-    Eigen::Matrix<double, 3, 2> wm;
-    for (int j = 0; j < 2; ++j)
-      for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-    return corner_upper<2>(wm, err, eigenvectors);
-  }
-  Eigen::Matrix<double, 3, 3> wm;
-  for (int j = 0; j < 3; ++j)
-    for (int c = 0; c < 3; ++c) wm(c, j) = at(j, c);
-  return corner_upper<3>(wm, err, eigenvectors);
+  if (space.dim() == 2) return corner_upper<2>(w_at<2>(space, w, k), err, eigenvectors);
+  return corner_upper<3>(w_at<3>(space, w, k), err, eigenvectors);
 }
 
 }  // namespace quadval
