@@ -9,12 +9,16 @@
 // Counters: elements/s (wall), and the answers so a regression in them shows.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <random>
 #include <utility>
+#include <vector>
 
+#include "analysis/jacobian_engine.hpp"
+#include "analysis/jacobian_space.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/io.hpp"
 #include "quadval/lagrange_basis.hpp"
@@ -202,6 +206,64 @@ void BM_CheckSharedCurved(benchmark::State& state, const std::string& name) {
   state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
                                                     benchmark::Counter::kIsIterationInvariantRate);
 }
+// The quality measures of `check` (mu, the scaled Jacobian; validity included) on a shared
+// mesh, one thread, at the CLI's default tolerance: Arg 0 mu, 1 the scaled Jacobian.
+void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
+  const char* env = std::getenv("QUADVAL_SHARED_DIR");
+  const std::string dir =
+      env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
+  Mesh mesh;
+  try {
+    mesh = read_mesh(dir + "/data/curved/" + name + ".msh");
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  CheckOptions o;
+  o.threads = 1;
+  o.measure = state.range(0) == 0 ? CheckMeasure::mu : CheckMeasure::scaled_jacobian;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(check_mesh_streamed(mesh, o, name, {}));
+  state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// The product kernel alone (jacobian_coefficients: nodes -> Bézier coefficients of J and
+// their error bounds) over the first block of a shared mesh, in chunks of 64 as `check`
+// calls it; the nodes are gathered once, outside the timing.
+void BM_JacobianProductKernel(benchmark::State& state, const std::string& name) {
+  const char* env = std::getenv("QUADVAL_SHARED_DIR");
+  const std::string dir =
+      env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
+  Mesh mesh;
+  try {
+    mesh = read_mesh(dir + "/data/curved/" + name + ".msh");
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  const ElementBlock& blk = mesh.blocks.front();
+  const JacobianSpace& space = jacobian_space(*blk.type);
+  const auto nn = static_cast<std::size_t>(blk.type->num_nodes);
+  const auto s = static_cast<std::size_t>(space.basis().size());
+  const bool planar = blk.type->dim == 2;
+  std::vector<double> nodes;
+  for (std::size_t e = 0; e < blk.size(); ++e)
+    for (NodeIndex n : blk.element(e))
+      for (std::size_t j = 0; j < 3; ++j) nodes.push_back(mesh.coords[3 * static_cast<std::size_t>(n) + j]);
+  constexpr std::size_t kChunk = 64;
+  std::vector<double> coeffs(kChunk * s), errors(kChunk);
+  ProductScratch scratch;
+  for (auto _ : state)
+    for (std::size_t e = 0; e < blk.size(); e += kChunk) {
+      jacobian_coefficients(space, nodes.data() + e * nn * 3, std::min(kChunk, blk.size() - e), planar,
+                            coeffs.data(), errors.data(), scratch);
+      benchmark::DoNotOptimize(coeffs.data());
+    }
+  state.counters["elements/s"] = benchmark::Counter(static_cast<double>(blk.size()),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
+}
+
 const bool kSharedCurvedRegistered = [] {
   for (const char* name :
        {"hex_box_N20_amp0.35_seed777", "mixed_h0.6_o2", "quad_h0.4_o2", "tets_h0.8_o2",
@@ -212,6 +274,19 @@ const bool kSharedCurvedRegistered = [] {
                                  [name](benchmark::State& s) { BM_CheckSharedCurved(s, name); })
         ->Arg(1)
         ->Arg(2)
+        ->Unit(benchmark::kMicrosecond);
+  for (const char* name : {"hex_box_N20_amp0.35_seed777", "quad_h0.4_o2", "tets_h0.8_o2", "tri_h0.4_o4",
+                           "warped_hexahedron_o2_N6_a0.25", "warped_prism_o2_N6_a0.25",
+                           "warped_tetrahedron_o3_N6_a0.25"})
+    benchmark::RegisterBenchmark((std::string("BM_CheckSharedQuality/") + name).c_str(),
+                                 [name](benchmark::State& s) { BM_CheckSharedQuality(s, name); })
+        ->Arg(0)
+        ->Arg(1)
+        ->Unit(benchmark::kMicrosecond);
+  for (const char* name : {"quad_h0.4_o2", "tets_h0.8_o2", "tri_h0.4_o4", "warped_hexahedron_o2_N6_a0.25",
+                           "warped_prism_o2_N6_a0.25", "warped_tetrahedron_o3_N6_a0.25"})
+    benchmark::RegisterBenchmark((std::string("BM_JacobianProductKernel/") + name).c_str(),
+                                 [name](benchmark::State& s) { BM_JacobianProductKernel(s, name); })
         ->Unit(benchmark::kMicrosecond);
   return true;
 }();

@@ -84,40 +84,85 @@ struct Leaf {
   long id;  // creation order: a deterministic tie-break
 };
 
+// What a Quotient needs of its space, the same for every element of it: the leaf layout,
+// the frames, and the frame columns that differ other than in sign (a hexahedron's 8
+// corner frames use 3, a tetrahedron's 4 use its 6 edges), whose squared norms each leaf
+// computes once.
+struct QuotientLayout {
+  const SpaceTools* j_tools = nullptr;
+  std::array<const SpaceTools*, 3> col_tools{};
+  std::array<std::size_t, 4> offset{};  // of J (0) and of column c (c + 1) in a leaf
+  std::array<std::size_t, 3> size{};    // coefficients of column c, per coordinate
+  std::size_t stride = 0;
+  std::vector<FrameColumn> distinct;              // frame columns, first weight positive
+  std::vector<std::array<std::size_t, 3>> frames;  // per frame: its columns in `distinct`
+};
+
+QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput& in) {
+  QuotientLayout q;
+  const auto dim = static_cast<std::size_t>(space.dim());
+  QV_ASSERT(dim >= 1 && dim <= 3, "dimension " << dim);
+  q.j_tools = &tools_of(*in.j_degrees);
+  std::size_t at = in.j.size();
+  for (std::size_t c = 0; c < dim; ++c) {
+    q.col_tools[c] = &tools_of(*in.col_degrees[c]);
+    q.offset[c + 1] = at;
+    q.size[c] = in.col[c][0].size();
+    at += 3 * q.size[c];
+    QV_ASSERT(q.col_tools[c]->corners.size() == q.j_tools->corners.size(), "corner counts differ");
+  }
+  q.stride = at;
+  for (const Frame& fr : space.frames()) {
+    std::array<std::size_t, 3> slots{};
+    for (std::size_t j = 0; j < dim; ++j) {
+      FrameColumn f;
+      for (std::size_t c = 0; c < dim; ++c)
+        if (fr[j][c] != 0) {
+          f.column[static_cast<std::size_t>(f.terms)] = static_cast<int>(c);
+          f.weight[static_cast<std::size_t>(f.terms++)] = fr[j][c];
+        }
+      QV_ASSERT(f.terms > 0, "empty frame column");
+      for (int t = 0; t < f.terms; ++t)
+        QV_ASSERT(q.size[static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)])] ==
+                      q.size[static_cast<std::size_t>(f.column[0])],
+                  "a frame sums columns of different spaces");
+      // -v has the norm of v, and its computed coordinates are exactly those of v negated.
+      if (f.weight[0] < 0)
+        for (double& w : f.weight) w = -w;
+      const auto same = [&](const FrameColumn& g) {
+        return g.terms == f.terms && g.column == f.column && g.weight == f.weight;
+      };
+      const auto it = std::find_if(q.distinct.begin(), q.distinct.end(), same);
+      slots[j] = static_cast<std::size_t>(it - q.distinct.begin());
+      if (it == q.distinct.end()) q.distinct.push_back(f);
+    }
+    q.frames.push_back(slots);
+  }
+  return q;
+}
+
+// The layout of a space, built once per thread.
+const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const QuotientInput& in) {
+  thread_local std::vector<std::pair<const ScaledJacobianSpace*, std::unique_ptr<QuotientLayout>>> cache;
+  for (const auto& [key, layout] : cache)
+    if (key == &space) return *layout;
+  cache.emplace_back(&space, std::make_unique<QuotientLayout>(make_layout(space, in)));
+  return *cache.back().second;
+}
+
 // The leaves' data: per leaf J then the columns' coordinates, contiguous; per leaf the
 // error bounds of J and of each column, and its bisection state.
 class Quotient {
  public:
-  Quotient(const ScaledJacobianSpace& space, const QuotientInput& in) : space_(space), in_(in) {
+  Quotient(const ScaledJacobianSpace& space, const QuotientInput& in)
+      : space_(space), in_(in), layout_(layout_of(space, in)) {
     dim_ = static_cast<std::size_t>(space.dim());
-    QV_ASSERT(dim_ >= 1 && dim_ <= 3, "dimension " << dim_);
-    j_tools_ = &tools_of(*in.j_degrees);
-    offset_[0] = 0;
-    std::size_t at = in.j.size();
-    for (std::size_t c = 0; c < dim_; ++c) {
-      col_tools_[c] = &tools_of(*in.col_degrees[c]);
-      offset_[c + 1] = at;
-      size_[c] = in.col[c][0].size();
-      at += 3 * size_[c];
-      QV_ASSERT(col_tools_[c]->corners.size() == j_tools_->corners.size(), "corner counts differ");
-    }
-    stride_ = at;
-    for (const Frame& fr : space.frames()) {
-      std::array<FrameColumn, 3> f{};
-      for (std::size_t j = 0; j < dim_; ++j) {
-        for (std::size_t c = 0; c < dim_; ++c)
-          if (fr[j][c] != 0) {
-            f[j].column[static_cast<std::size_t>(f[j].terms)] = static_cast<int>(c);
-            f[j].weight[static_cast<std::size_t>(f[j].terms++)] = fr[j][c];
-          }
-        QV_ASSERT(f[j].terms > 0, "empty frame column");
-        for (int t = 0; t < f[j].terms; ++t)
-          QV_ASSERT(size_[static_cast<std::size_t>(f[j].column[static_cast<std::size_t>(t)])] ==
-                        size_[static_cast<std::size_t>(f[j].column[0])],
-                    "a frame sums columns of different spaces");
-      }
-      frames_.push_back(f);
-    }
+    j_tools_ = layout_.j_tools;
+    col_tools_ = layout_.col_tools;
+    offset_ = layout_.offset;
+    size_ = layout_.size;
+    stride_ = layout_.stride;
+    QV_ASSERT(offset_[1] == in.j.size() && size_[0] == in.col[0][0].size(), "the layout of another input");
   }
 
   std::size_t stride() const { return stride_; }
@@ -140,49 +185,59 @@ class Quotient {
     const double j_lo = down(*std::min_element(leaf, leaf + sj) - err[0]);
     const std::vector<int>& j_corners = j_tools_->corners;
     const std::size_t corners = j_corners.size();
-    double lower = kInf;
-    for (const auto& fr : frames_) {
-      double norm_product = 1;
-      sumsq_.clear();
-      std::array<std::size_t, 3> first{}, col0{};
-      std::array<double, 3> spread{};
-      for (std::size_t j = 0; j < dim_; ++j) {
-        const FrameColumn& f = fr[j];
-        double e = 0;
-        for (int t = 0; t < f.terms; ++t) {
-          const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-          e += err[c + 1] + gamma_ * in_.col_magnitude[c];
-        }
-        spread[j] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
-        col0[j] = static_cast<std::size_t>(f.column[0]);
-        const std::size_t n = size_[col0[j]];
-        first[j] = sumsq_.size();
-        double big = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-          double sum = 0;
-          for (std::size_t x = 0; x < 3; ++x) {
-            double v = 0;
-            for (int t = 0; t < f.terms; ++t) {
-              const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-              v += f.weight[static_cast<std::size_t>(t)] * leaf[offset_[c + 1] + x * n + i];
-            }
-            sum += v * v;
-          }
-          sumsq_.push_back(sum);
-          big = std::max(big, sum);
-        }
-        norm_product = up(norm_product * up(up(std::sqrt(big) * (1 + 1e-12)) + spread[j]));
+    // Each distinct frame column: the squared norms of its control points, their largest,
+    // and the spread of its norms from the columns' errors.
+    const std::size_t nd = layout_.distinct.size();
+    sumsq_.clear();
+    first_.resize(nd);
+    col0_.resize(nd);
+    big_.resize(nd);
+    spread_.resize(nd);
+    for (std::size_t d = 0; d < nd; ++d) {
+      const FrameColumn& f = layout_.distinct[d];
+      double e = 0;
+      for (int t = 0; t < f.terms; ++t) {
+        const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+        e += err[c + 1] + gamma_ * in_.col_magnitude[c];
       }
+      spread_[d] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
+      col0_[d] = static_cast<std::size_t>(f.column[0]);
+      const std::size_t n = size_[col0_[d]];
+      first_[d] = sumsq_.size();
+      double big = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        double sum = 0;
+        for (std::size_t x = 0; x < 3; ++x) {
+          double v = 0;
+          for (int t = 0; t < f.terms; ++t) {
+            const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+            v += f.weight[static_cast<std::size_t>(t)] * leaf[offset_[c + 1] + x * n + i];
+          }
+          sum += v * v;
+        }
+        sumsq_.push_back(sum);
+        big = std::max(big, sum);
+      }
+      big_[d] = big;
+    }
+    double lower = kInf;
+    for (const auto& fr : layout_.frames) {
+      double norm_product = 1;
+      for (std::size_t j = 0; j < dim_; ++j)
+        norm_product = up(norm_product * up(up(std::sqrt(big_[fr[j]]) * (1 + 1e-12)) + spread_[fr[j]]));
       // J > 0 on the element: sj > 0 everywhere, the bound where J_lo is not positive.
       lower = std::min(lower, j_lo > 0 ? down(space_.s_lo() * down(j_lo / norm_product)) : 0.0);
       // The corner of least sj estimated from the squares (any corner gives a true upper
       // bound; the estimate only picks a sharp one), then certified there.
+      const auto square_at = [&](std::size_t j, std::size_t m) {
+        const std::size_t d = fr[j];
+        return sumsq_[first_[d] + static_cast<std::size_t>(col_tools_[col0_[d]]->corners[m])];
+      };
       std::size_t best = corners;
       double best_square = kInf;
       for (std::size_t m = 0; m < corners; ++m) {
         double denominator = 1;
-        for (std::size_t j = 0; j < dim_; ++j)
-          denominator *= sumsq_[first[j] + static_cast<std::size_t>(col_tools_[col0[j]]->corners[m])];
+        for (std::size_t j = 0; j < dim_; ++j) denominator *= square_at(j, m);
         const double jm = leaf[j_corners[m]];
         if (denominator > 0 && jm > 0 && jm * jm / denominator < best_square) {
           best_square = jm * jm / denominator;
@@ -192,8 +247,7 @@ class Quotient {
       if (best == corners) continue;
       double denominator = 1;
       for (std::size_t j = 0; j < dim_; ++j) {
-        const double square = sumsq_[first[j] + static_cast<std::size_t>(col_tools_[col0[j]]->corners[best])];
-        const double norm_lo = down(down(std::sqrt(square) * (1 - 1e-12)) - spread[j]);
+        const double norm_lo = down(down(std::sqrt(square_at(j, best)) * (1 - 1e-12)) - spread_[fr[j]]);
         denominator = norm_lo > 0 ? down(denominator * norm_lo) : 0;
       }
       if (!(denominator > 0)) continue;  // a column may vanish there: no value from this corner
@@ -239,14 +293,15 @@ class Quotient {
  private:
   const ScaledJacobianSpace& space_;
   const QuotientInput& in_;
+  const QuotientLayout& layout_;
   std::size_t dim_ = 0, stride_ = 0;
   const SpaceTools* j_tools_ = nullptr;
   std::array<const SpaceTools*, 3> col_tools_{};
   std::array<std::size_t, 4> offset_{};  // of J (0) and of column c (c + 1) in a leaf
   std::array<std::size_t, 3> size_{};    // coefficients of column c, per coordinate
-  std::vector<std::array<FrameColumn, 3>> frames_;
   const double gamma_ = rounding_gamma(6);  // of a frame column's sum of <= 3 columns
-  mutable std::vector<double> sumsq_, part_, scratch_;
+  mutable std::vector<double> sumsq_, part_, scratch_, big_, spread_;
+  mutable std::vector<std::size_t> first_, col0_;
   mutable std::vector<BisectionState> column_states_;
 };
 
