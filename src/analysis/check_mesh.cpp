@@ -25,6 +25,7 @@
 #include "analysis/jacobian_space.hpp"
 #include "analysis/check_summary.hpp"
 #include "analysis/linear_jacobian.hpp"
+#include "analysis/straight_sided.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
@@ -257,6 +258,15 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     }
   }
   work *= weight;
+  // Validity of curved blocks: the straight-sided elements' margins (straight_sided.hpp).
+  std::vector<std::unique_ptr<const StraightSidedMargin>> straight_of(mesh.blocks.size());
+  for (std::size_t b = 0; b < mesh.blocks.size() && fast_path; ++b) {
+    const ElementType& type = *mesh.blocks[b].type;
+    if (type.dim != report.dimension || !jacobian_supported(type) || linear_kind(type, report.planar) != LinearKind::none)
+      continue;
+    auto straight = std::make_unique<const StraightSidedMargin>(type, jacobian_space(type), report.planar);
+    if (straight->kind() != LinearKind::none) straight_of[b] = std::move(straight);
+  }
   // Threads only for work worth them: each extra one costs its start (about 0.1 ms,
   // worker_threads.hpp) and the closing join, and more when the cores are busy
   // (results do not depend on it), so one thread per kWorkPerThread units (about 1 ms),
@@ -319,7 +329,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(thread)];
-    std::vector<double> nodes, errors, coeffs, soa;
+    std::vector<double> nodes, errors, coeffs, soa, margins;
+    std::vector<std::size_t> rest;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
     const Buffer own = batched ? Buffer{} : make_buffer(kFastChunk);  // the largest chunk
@@ -446,21 +457,64 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   for (std::size_t j = 0; j < 3; ++j)
                     nodes[(i * nn + k) * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
               }
-              coeffs.resize(ch.count * s);
-              errors.resize(ch.count);
+              // Validity: straight-sided elements first, by the first-order fast path with
+              // a margin (straight_sided.hpp); the rest, listed in `rest`, go on below.
+              std::size_t left = 0;
+              rest.resize(ch.count);
+              if (const StraightSidedMargin* straight = straight_of[ch.block].get()) {
+                const std::uint64_t ts = stage_ticks();
+                const auto nv = static_cast<std::size_t>(linear_num_vertices(straight->kind()));
+                soa.resize(nv * 3 * kLinearChunk);
+                margins.resize(kLinearChunk);
+                straight->margins(nodes.data(), ch.count, margins.data());
+                for (std::size_t i = 0; i < ch.count; ++i)
+                  for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearChunk + i] = nodes[i * nn * 3 + k];
+                fast_bounds.resize(ch.count);
+                linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
+                                      margins.data());
+                const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
+                for (std::size_t i = 0; i < ch.count; ++i) {
+                  if (!decided[i]) {
+                    rest[left++] = i;
+                    continue;
+                  }
+                  elements[ch.out + i].bounds = fast_bounds[i];
+                  finish(ch.out + i, nodes.data() + i * nn * 3, share);
+                }
+                // The rest's nodes to the front, in order (rest[k] >= k).
+                for (std::size_t k = 0; k < left; ++k)
+                  if (rest[k] != k)
+                    std::copy_n(nodes.data() + rest[k] * nn * 3, nn * 3, nodes.data() + k * nn * 3);
+              } else {
+                for (std::size_t i = 0; i < ch.count; ++i) rest[left++] = i;
+              }
+              // A tail of 2 or more elements is padded to a whole lane block with copies
+              // of the last element: one block costs less than two elements one by one
+              // (a lane's results do not depend on the others').
+              constexpr std::size_t kLanes = JacobianProduct::kLanes;
+              const std::size_t padded = left % kLanes >= 2 ? (left + kLanes - 1) / kLanes * kLanes : left;
+              if (padded > left) {
+                nodes.resize(std::max(nodes.size(), padded * nn * 3));
+                for (std::size_t k = left; k < padded; ++k)
+                  std::copy_n(nodes.data() + (left - 1) * nn * 3, nn * 3, nodes.data() + k * nn * 3);
+              }
+              coeffs.resize(padded * s);
+              errors.resize(padded);
               const std::uint64_t ts = stage_ticks();
-              jacobian_coefficients(space, nodes.data(), ch.count, report.planar, coeffs.data(),
-                                    errors.data(), ws.sample_scratch.product);
+              if (left > 0)
+                jacobian_coefficients(space, nodes.data(), padded, report.planar, coeffs.data(), errors.data(),
+                                      ws.sample_scratch.product);
               std::uint64_t te = stage_ticks();
-              const double batch_share = static_cast<double>(te - ts) / static_cast<double>(ch.count);
+              const double batch_share = static_cast<double>(te - ts) / static_cast<double>(std::max<std::size_t>(left, 1));
               // One clock read per element when `finish` is only bookkeeping (its time then
               // counts in the next element's stage); mu, the scaled Jacobian and distortion
               // in `finish` are kept out of the stage times.
               const bool light_finish = !want_mu && !want_sj && !measures_distortion(options.measure);
-              for (std::size_t i = 0; i < ch.count; ++i) {
+              for (std::size_t k = 0; k < left; ++k) {
+                const std::size_t i = rest[k];
                 ElementCheck& ec = elements[ch.out + i];
-                const double* xe = nodes.data() + i * nn * 3;
-                ec.bounds = bounds_from_coefficients(space, coeffs.data() + i * s, errors[i], xe,
+                const double* xe = nodes.data() + k * nn * 3;
+                ec.bounds = bounds_from_coefficients(space, coeffs.data() + k * s, errors[k], xe,
                                                      report.planar, bo, ws);
                 const std::uint64_t done_at = stage_ticks();
                 finish(ch.out + i, xe, batch_share + static_cast<double>(done_at - te));

@@ -83,6 +83,13 @@ class JacobianProduct {
   /// Nodes read per element: all of them (curved) or the vertices (straight).
   int num_nodes(SampleMap map) const noexcept { return maps_[static_cast<int>(map)].num_nodes; }
 
+  /// max_k sum_i |G_ki|, rounded up, where G_ki is the Bézier coefficient k of the
+  /// derivative in Gmsh direction c of node i's shape function: |d f / d xi_c| <= this
+  /// times max_i |f_i| on the element, for any nodal values f_i.
+  double derivative_row_sum(SampleMap map, int c) const noexcept {
+    return maps_[static_cast<int>(map)].row_sum[static_cast<std::size_t>(c)];
+  }
+
   /// Bézier coefficients of J for `count` elements at once, each with a bound on the error
   /// of every one of its coefficients.
   /// @param nodes   count x #nodes x 3 (Gmsh node order; the full node list also for

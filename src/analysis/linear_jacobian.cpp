@@ -239,7 +239,7 @@ inline Lanes next_down_finite(Lanes x) {
 // LinearFastPath.ChunkBoundsAreTheDocumentedOutwardRoundedValues checks); only the final
 // stores are per element.
 template <LinearKind kKind>
-void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, bool* decided) {
+void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, bool* decided, const double* margins) {
   constexpr int n = num_coefficients(kKind);
   for (std::size_t e = 0; e < count; e += kLanes) {
     const auto point = [&](int v) {
@@ -254,7 +254,12 @@ void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, boo
     // err (before rounding up) is a positive normal number (every L in [2^-200, 2^200]),
     // +inf, or a quiet NaN (NaN input), never 0: next_up is bits + 1 for the first, and
     // the others become (or stay) NaN, which decides nothing.
-    const Lanes err = next_up_nonzero(coefficients_of(kKind, point, c));
+    Lanes err = next_up_nonzero(coefficients_of(kKind, point, c));
+    if (margins != nullptr) {  // J within the margin of these coefficients' polynomial
+      Lanes m;
+      std::memcpy(&m, margins + e, sizeof m);
+      err = next_up_nonzero(err + m);
+    }
     // (sum from c[0], not 0 + c[0]: the same bits for every finite c[0], -0 included,
     // and a non-finite c[0] leaves the element undecided either way)
     Lanes lo = c[0], hi = c[0], vlo = c[0], vhi = c[0], sum = c[0];
@@ -345,13 +350,13 @@ double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double
 }
 
 void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,
-                           JacobianBounds* out, bool* decided) noexcept {
+                           JacobianBounds* out, bool* decided, const double* margins) noexcept {
   switch (kind) {
-    case LinearKind::hexahedron: return decide_chunk<LinearKind::hexahedron>(soa, count, out, decided);
-    case LinearKind::quadrangle: return decide_chunk<LinearKind::quadrangle>(soa, count, out, decided);
-    case LinearKind::tetrahedron: return decide_chunk<LinearKind::tetrahedron>(soa, count, out, decided);
-    case LinearKind::triangle: return decide_chunk<LinearKind::triangle>(soa, count, out, decided);
-    case LinearKind::pyramid: return decide_chunk<LinearKind::pyramid>(soa, count, out, decided);
+    case LinearKind::hexahedron: return decide_chunk<LinearKind::hexahedron>(soa, count, out, decided, margins);
+    case LinearKind::quadrangle: return decide_chunk<LinearKind::quadrangle>(soa, count, out, decided, margins);
+    case LinearKind::tetrahedron: return decide_chunk<LinearKind::tetrahedron>(soa, count, out, decided, margins);
+    case LinearKind::triangle: return decide_chunk<LinearKind::triangle>(soa, count, out, decided, margins);
+    case LinearKind::pyramid: return decide_chunk<LinearKind::pyramid>(soa, count, out, decided, margins);
     case LinearKind::none: break;
   }
   std::fill(decided, decided + count, false);

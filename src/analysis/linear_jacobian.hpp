@@ -100,7 +100,10 @@ double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double
 ///                coefficients > err) or invalid (stage 0, a vertex value proven <= 0).
 ///                Bounds are as the general path's stage-1 bounds: jmin in [min c - err,
 ///                min vertex c + err], jmax in [max vertex c - err, max c + err], outward.
+/// @param margins optional, kLinearChunk entries (as soa, those past count are read):
+///                element e's J differs from its vertices' first-order J by at most
+///                margins[e] (straight_sided.hpp), which widens err; +inf decides nothing
 void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,
-                           JacobianBounds* out, bool* decided) noexcept;
+                           JacobianBounds* out, bool* decided, const double* margins = nullptr) noexcept;
 
 }  // namespace quadval

@@ -7,6 +7,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/jacobian_bounds.cpp
   src/analysis/ratio_refinement.cpp
   src/analysis/linear_jacobian.cpp
+  src/analysis/straight_sided.cpp
   src/analysis/scaled_jacobian_space.cpp
   src/analysis/scaled_jacobian_quotient.cpp
   src/analysis/scaled_jacobian.cpp

@@ -17,6 +17,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/quality_cli_test.cpp
   analysis/pyramid_jacobian_test.cpp
   analysis/linear_fast_path_test.cpp
+  analysis/straight_sided_test.cpp
   analysis/jacobian_batch_test.cpp
   analysis/check_threads_test.cpp
   analysis/worker_threads_test.cpp

@@ -1,0 +1,188 @@
+// The margin of a straight-sided high-order element (straight_sided.hpp).
+#include "analysis/straight_sided.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "analysis/jacobian_product.hpp"
+#include "analysis/outward_rounding.hpp"
+#include "quadval/lagrange_basis.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kUnit = 0x1p-53;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kStraight = 1e-9;  // deviation / edge below which an element counts as straight
+constexpr double kUnderflow = 0x1p-1000;
+
+// W doubles side by side (GCC vector extension): the same IEEE operations lane by lane.
+constexpr int kLanes = 8;
+template <int W>
+struct LaneVector {
+  typedef double Type __attribute__((vector_size(8 * W)));
+};
+template <int W>
+using Lanes = typename LaneVector<W>::Type;
+template <class V>
+V vabs(V a) { return a < 0 ? -a : a; }
+template <class V>
+V vmax(V a, V b) { return a < b ? b : a; }
+
+// The first-order kind of a curved type's vertices.
+LinearKind vertex_kind(const ElementType& type, bool planar) noexcept {
+  if (type.order < 2 || !type.has_lagrange_basis) return LinearKind::none;
+  switch (type.family) {
+    case ElementFamily::triangle: return planar ? LinearKind::triangle : LinearKind::none;
+    case ElementFamily::quadrangle: return planar ? LinearKind::quadrangle : LinearKind::none;
+    case ElementFamily::tetrahedron: return LinearKind::tetrahedron;
+    case ElementFamily::hexahedron: return LinearKind::hexahedron;
+    default: return LinearKind::none;  // pyramids: Bergot's first-order map is not polynomial
+  }
+}
+
+// Per direction c, the vertex pairs (from, to) of the edges whose convex combination is
+// a_c (halved on [-1, 1]).
+struct Direction {
+  int edges;
+  int from[4], to[4];
+};
+constexpr Direction kTriangle[2] = {{1, {0}, {1}}, {1, {0}, {2}}};
+constexpr Direction kTetrahedron[3] = {{1, {0}, {1}}, {1, {0}, {2}}, {1, {0}, {3}}};
+constexpr Direction kQuadrangle[2] = {{2, {0, 3}, {1, 2}}, {2, {0, 1}, {3, 2}}};
+constexpr Direction kHexahedron[3] = {
+    {4, {0, 3, 4, 7}, {1, 2, 5, 6}}, {4, {0, 1, 4, 5}, {3, 2, 7, 6}}, {4, {0, 1, 2, 3}, {4, 5, 6, 7}}};
+
+const Direction* directions(LinearKind kind) noexcept {
+  switch (kind) {
+    case LinearKind::triangle: return kTriangle;
+    case LinearKind::tetrahedron: return kTetrahedron;
+    case LinearKind::quadrangle: return kQuadrangle;
+    case LinearKind::hexahedron: return kHexahedron;
+    default: return nullptr;
+  }
+}
+
+}  // namespace
+
+StraightSidedMargin::StraightSidedMargin(const ElementType& type, const JacobianSpace& space, bool planar)
+    : kind_(vertex_kind(type, planar)) {
+  if (kind_ == LinearKind::none || space.product() == nullptr) {
+    kind_ = LinearKind::none;
+    return;
+  }
+  num_nodes_ = type.num_nodes;
+  num_vertices_ = linear_num_vertices(kind_);
+  dim_ = type.dim;
+  axes_ = dim_ == 2 ? 2 : 3;
+  // N_v at every other node: barycentric on simplices, products of (1 +- xi) / 2 on
+  // quadrangles and hexahedra (the vertices' reference coordinates give the signs).
+  const auto nodes = reference_nodes(type);
+  const auto vertices = reference_vertices(type.family);
+  const bool simplex = kind_ == LinearKind::triangle || kind_ == LinearKind::tetrahedron;
+  for (int i = num_vertices_; i < num_nodes_; ++i) {
+    const RefPoint& x = nodes[static_cast<std::size_t>(i)];
+    NodeTerms t;
+    for (int v = 1; v < num_vertices_; ++v) {
+      double n = 1;
+      if (simplex) {
+        n = x[static_cast<std::size_t>(v - 1)];
+      } else {
+        for (int k = 0; k < dim_; ++k)
+          n *= (1 + vertices[static_cast<std::size_t>(v)][static_cast<std::size_t>(k)] * x[static_cast<std::size_t>(k)]) / 2;
+      }
+      if (n == 0) continue;
+      t.vertex[static_cast<std::size_t>(t.count)] = v;
+      t.value[static_cast<std::size_t>(t.count++)] = n;
+    }
+    terms_.push_back(t);
+  }
+  for (int c = 0; c < dim_; ++c) lambda_[static_cast<std::size_t>(c)] = space.product()->derivative_row_sum(SampleMap::curved, c);
+  // N~ within 8u of N (at most three roundings of values in [-1, 2], and the reference
+  // coordinate's own); the products N~ y~ and the sum of n_v terms: (n_v + 3) u more of
+  // sum |y_v|; the differences y = x - x_0 and d = y_i - sum: 3u; so (n_v + 14) u S, twice.
+  deviation_error_ = 2 * (num_vertices_ + 14) * kUnit;
+}
+
+template <int W>
+void StraightSidedMargin::lane_margins(const double* nodes, double* out) const noexcept {
+  using V = Lanes<W>;
+  const auto nn = static_cast<std::size_t>(num_nodes_);
+  const auto nv = static_cast<std::size_t>(num_vertices_);
+  const auto axes = static_cast<std::size_t>(axes_);
+  const auto at = [&](std::size_t i, std::size_t j) {  // coordinate j of node i, every lane
+    V v;
+    for (std::size_t l = 0; l < W; ++l) v[l] = nodes[(l * nn + i) * 3 + j];
+    return v;
+  };
+  // y_v = x_v - x_0 of the vertices, and sum_v |y_v| per axis.
+  V x0[3], y[8][3], vertex_sum[3] = {};
+  for (std::size_t j = 0; j < axes; ++j) x0[j] = at(0, j);
+  for (std::size_t v = 1; v < nv; ++v)
+    for (std::size_t j = 0; j < axes; ++j) {
+      y[v][j] = at(v, j) - x0[j];
+      vertex_sum[j] += vabs(y[v][j]);
+    }
+  // The largest deviation and the largest |y| of the other nodes, per axis; `finite` sums
+  // the deviations, so that a NaN or infinite coordinate (which max would drop) shows.
+  V deviation[3] = {}, largest[3] = {}, finite = {};
+  for (std::size_t i = nv; i < nn; ++i) {
+    const NodeTerms& t = terms_[i - nv];
+    for (std::size_t j = 0; j < axes; ++j) {
+      const V yi = at(i, j) - x0[j];
+      V lin = {};
+      for (int k = 0; k < t.count; ++k)
+        lin += t.value[static_cast<std::size_t>(k)] * y[static_cast<std::size_t>(t.vertex[static_cast<std::size_t>(k)])][j];
+      const V d = vabs(yi - lin);
+      deviation[j] = vmax(deviation[j], d);
+      largest[j] = vmax(largest[j], vabs(yi));
+      finite += d;
+    }
+  }
+  V delta = {};
+  for (std::size_t j = 0; j < axes; ++j)
+    delta += deviation[j] + deviation_error_ * (largest[j] + vertex_sum[j]) + kUnderflow;
+  // alpha_c: the largest 1-norm of the edges of direction c (halved on [-1, 1]).
+  const Direction* dirs = directions(kind_);
+  const double half = kind_ == LinearKind::triangle || kind_ == LinearKind::tetrahedron ? 1.0 : 0.5;
+  V alpha[3] = {}, edge = {};
+  for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) {
+    for (int k = 0; k < dirs[c].edges; ++k) {
+      const auto from = static_cast<std::size_t>(dirs[c].from[k]), to = static_cast<std::size_t>(dirs[c].to[k]);
+      V norm = {};
+      for (std::size_t j = 0; j < axes; ++j) norm += vabs((to == 0 ? V{} : y[to][j]) - (from == 0 ? V{} : y[from][j]));
+      alpha[c] = vmax(alpha[c], norm);
+      finite += norm;
+    }
+    edge = vmax(edge, alpha[c]);
+    alpha[c] *= half * (1 + 1e-12);
+  }
+  // y_to - y_from = x_to - x_from up to the roundings of y (2u relative to |y|), which the
+  // factor 1 + 1e-12 covers with the 1-norm's own.
+  V beta[3] = {};
+  for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) beta[c] = lambda_[c] * delta * (1 + 1e-12);
+  // prod (alpha + beta) - prod alpha, as a sum of nonnegative terms.
+  const V m = dim_ == 3 ? beta[0] * (alpha[1] + beta[1]) * (alpha[2] + beta[2]) +
+                              alpha[0] * (beta[1] * (alpha[2] + beta[2]) + alpha[1] * beta[2])
+                        : beta[0] * (alpha[1] + beta[1]) + alpha[0] * beta[1];
+  const V widened = m * (1 + 1e-12);
+  for (std::size_t l = 0; l < W; ++l) {
+    // Straight (every comparison with NaN is false) and finite, else +inf.
+    const bool straight = delta[l] <= kStraight * edge[l] && finite[l] <= std::numeric_limits<double>::max();
+    out[l] = straight ? next_up(widened[l]) : kInf;
+  }
+}
+
+void StraightSidedMargin::margins(const double* nodes, std::size_t count, double* out) const noexcept {
+  if (kind_ == LinearKind::none) {
+    std::fill(out, out + count, kInf);
+    return;
+  }
+  const std::size_t stride = static_cast<std::size_t>(num_nodes_) * 3;
+  std::size_t e = 0;
+  for (; e + kLanes <= count; e += kLanes) lane_margins<kLanes>(nodes + e * stride, out + e);
+  for (; e < count; ++e) lane_margins<1>(nodes + e * stride, out + e);
+}
+
+}  // namespace quadval
