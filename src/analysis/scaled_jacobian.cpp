@@ -10,12 +10,17 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "analysis/jacobian_samples.hpp"
+#include "analysis/linear_jacobian.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_quotient.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
@@ -398,7 +403,77 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
   }
 }
 
+thread_local bool use_straight_path = true;
+
+// The straight-sided margin of a simplex type, built once per thread (straight_sided.hpp).
+const StraightSidedMargin& straight_margin_of(const ElementType& type) {
+  thread_local std::vector<std::pair<const ElementType*, std::unique_ptr<const StraightSidedMargin>>> cache;
+  for (const auto& [key, margin] : cache)
+    if (key == &type) return *margin;
+  cache.emplace_back(&type, std::make_unique<const StraightSidedMargin>(type, jacobian_space(type), true));
+  return *cache.back().second;
+}
+
+// A valid straight-sided simplex (planar triangle, tetrahedron; order 1, or higher with a
+// finite straight_sided.hpp margin): its columns are the edges a_c = x_c - x_0 up to beta_c
+// (0 at order 1) and J is J_1 up to the margin m, so on the whole element each frame's
+// s J / prod_j |v_j| lies between s (J_1 - m) / prod (|v~_j| + e_j) and s (J_1 + m) / prod
+// (|v~_j| - e_j), v~_j the frame's columns computed from the edges and e_j the sum of
+// beta_c over its columns plus 4u of their 1-norms (the edges' and sums' roundings); the
+// norms' own few ulps are covered by 1 +- 1e-12, J_1's rounding by linear_jacobian's err.
+// The minimum over the frames of each bound bounds min sj. Nothing when the element is not
+// such a simplex or the bounds are wider than tol.
+std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& space, std::span<const double> x,
+                                                     bool planar, double tol) {
+  const ElementType& type = space.type();
+  const bool triangle = type.family == ElementFamily::triangle && planar;
+  if (!use_straight_path || !(triangle || type.family == ElementFamily::tetrahedron)) return std::nullopt;
+  std::array<double, 3> beta{0, 0, 0};
+  double m = 0;
+  if (type.order > 1) {
+    m = straight_margin_of(type).margin(x.data(), beta);
+    if (!(m < kInf)) return std::nullopt;
+  }
+  const LinearKind kind = triangle ? LinearKind::triangle : LinearKind::tetrahedron;
+  double j1 = 0;
+  const double err = linear_jacobian_coefficients(kind, x.data(), &j1);
+  const double j_lo = down(down(j1 - err) - m), j_hi = up(up(j1 + err) + m);
+  if (!(j_lo > 0) || !(j_hi < kInf)) return std::nullopt;
+  const std::size_t dim = type.dim == 2 ? 2 : 3;
+  std::array<std::array<double, 3>, 3> a{};  // edges a_c, and their 1-norms
+  std::array<double, 3> a_norm1{0, 0, 0};
+  for (std::size_t c = 0; c < dim; ++c)
+    for (std::size_t j = 0; j < 3; ++j) {
+      a[c][j] = x[3 * (c + 1) + j] - x[j];
+      a_norm1[c] += std::abs(a[c][j]);
+    }
+  QualityBounds out{kInf, kInf, 0, false};
+  for (const Frame& fr : space.frames()) {
+    double den_hi = 1, den_lo = 1;
+    for (std::size_t j = 0; j < dim; ++j) {
+      double v[3] = {0, 0, 0}, e = 0;
+      for (std::size_t c = 0; c < dim; ++c) {
+        if (fr[j][c] == 0) continue;
+        for (std::size_t k = 0; k < 3; ++k) v[k] += fr[j][c] * a[c][k];
+        e += beta[c] + 4 * kUnit * a_norm1[c];
+      }
+      const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      e = up(e * (1 + 1e-12));
+      den_hi = up(den_hi * up(up(norm * (1 + 1e-12)) + e));
+      den_lo = down(den_lo * std::max(0.0, down(down(norm * (1 - 1e-12)) - e)));
+    }
+    if (!(den_lo > 0)) return std::nullopt;
+    out.lower = std::min(out.lower, down(space.s_lo() * down(j_lo / den_hi)));
+    out.upper = std::min(out.upper, up(space.s_hi() * up(j_hi / den_lo)));
+  }
+  out.tolerance_met = up(out.upper - out.lower) <= tol;
+  if (!out.tolerance_met) return std::nullopt;
+  return out;
+}
+
 }  // namespace
+
+void scaled_jacobian_use_straight_path(bool on) noexcept { use_straight_path = on; }
 
 QualityBounds scaled_jacobian_bounds(const ElementType& type, std::span<const double> nodes,
                                      const QualityOptions& options, bool planar) {
@@ -438,6 +513,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   const auto udim = static_cast<std::size_t>(dim);
   const std::size_t frames = space.frames().size();
 
+  if (v == Validity::valid)
+    if (const auto straight = straight_simplex_bounds(space, nodes, planar, options.abs_tol)) return *straight;
   thread_local Polys polys;
   auto& col = polys.col;
   const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2

@@ -85,6 +85,11 @@ const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type);
 QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<const double> nodes, bool planar,
                                              double tol, int max_splits);
 
+/// Tests only: switch off (on by default), in the calling thread, the closed-form bounds of
+/// valid straight-sided simplices (planar triangles, tetrahedra: columns within the
+/// straight_sided.hpp margins of their edges), to compare them with the general path.
+void scaled_jacobian_use_straight_path(bool on) noexcept;
+
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian
 /// engine (jacobian_bounds, any goal: only the sign of min J is used), as check_mesh has
 /// it; results are identical. @pre v is that element's certified validity.

@@ -106,7 +106,7 @@ StraightSidedMargin::StraightSidedMargin(const ElementType& type, const Jacobian
 }
 
 template <int W>
-void StraightSidedMargin::lane_margins(const double* nodes, double* out) const noexcept {
+void StraightSidedMargin::lane_margins(const double* nodes, double* out, double* beta_out) const noexcept {
   using V = Lanes<W>;
   const auto nn = static_cast<std::size_t>(num_nodes_);
   const auto nv = static_cast<std::size_t>(num_vertices_);
@@ -171,7 +171,16 @@ void StraightSidedMargin::lane_margins(const double* nodes, double* out) const n
     // Straight (every comparison with NaN is false) and finite, else +inf.
     const bool straight = delta[l] <= kStraight * edge[l] && finite[l] <= std::numeric_limits<double>::max();
     out[l] = straight ? next_up(widened[l]) : kInf;
+    if (beta_out != nullptr)
+      for (std::size_t c = 0; c < 3; ++c) beta_out[l * 3 + c] = beta[c][l];
   }
+}
+
+double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& beta) const noexcept {
+  if (kind_ == LinearKind::none) return kInf;
+  double m = kInf;
+  lane_margins<1>(nodes, &m, beta.data());
+  return m;
 }
 
 void StraightSidedMargin::margins(const double* nodes, std::size_t count, double* out) const noexcept {

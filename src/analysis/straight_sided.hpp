@@ -55,9 +55,15 @@ class StraightSidedMargin {
   /// @param nodes count x #nodes x 3, Gmsh node order; @param out count margins
   void margins(const double* nodes, std::size_t count, double* out) const noexcept;
 
+  /// One element: its margin as above and beta_c >= |D_c| everywhere, the distance of
+  /// column c of the Jacobian matrix from the first-order element's (beta is left as is
+  /// where the margin is +inf).
+  double margin(const double* nodes, std::array<double, 3>& beta) const noexcept;
+
  private:
+  // W elements at once; beta (W x 3, optional) receives beta_c per element.
   template <int W>
-  void lane_margins(const double* nodes, double* out) const noexcept;  // W elements at once
+  void lane_margins(const double* nodes, double* out, double* beta = nullptr) const noexcept;
 
   // A node other than the vertices: its first-order shape values N_v != 0, v >= 1 (the
   // term of vertex 0 is 0: coordinates are taken relative to it).

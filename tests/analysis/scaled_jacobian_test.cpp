@@ -324,6 +324,45 @@ TEST(ScaledJacobian, FirstStageIsExactOnStraightElements) {
   EXPECT_GT(checked, 150);
 }
 
+// Valid straight-sided simplices get closed-form bounds (scaled_jacobian.cpp: the edges as
+// columns, within the straight-sided margin): they hold the pointwise value (constant per
+// frame on an affine element) and overlap the general path's, also with the high-order
+// nodes 1e-10 off their straight positions.
+TEST(ScaledJacobian, StraightSimplicesInClosedFormHoldTheValue) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int checked = 0;
+  for (const ElementType& t : element_types()) {
+    const bool simplex = t.family == ElementFamily::triangle || t.family == ElementFamily::tetrahedron;
+    if (!simplex || !scaled_jacobian_supported(t) || t.order > (t.dim == 2 ? 5 : 3)) continue;
+    SCOPED_TRACE(std::string(t.name));
+    const auto points = test::dense_points(t.family, 6, 50, rng);
+    for (int e = 0; e < 6; ++e) {
+      std::vector<double> x = test::random_element(t, 0.0, rng);
+      if (e % 2 == 1)
+        for (std::size_t i = 3 * static_cast<std::size_t>(t.dim + 1); i < x.size(); ++i)
+          if (!(t.dim == 2 && i % 3 == 2)) x[i] += 1e-10 * u(rng);
+      const QualityBounds b = bounds(t, x, 1e-6);
+      // Never above a sampled value; straight (e even): sj is constant, both bounds hold it.
+      EXPECT_LE(b.lower, sampled_min(t, x, points) + 1e-12);
+      if (e % 2 == 0) {
+        const double want = sj_at(t, x, reference_nodes(t)[0], {0, 0, 1}, chord(x));
+        EXPECT_GE(b.upper, want - 1e-12);
+        EXPECT_LE(b.upper - b.lower, 1e-10);
+      }
+      EXPECT_EQ(b.subdivisions, 0);
+      EXPECT_TRUE(b.tolerance_met);
+      scaled_jacobian_use_straight_path(false);
+      const QualityBounds g = bounds(t, x, 1e-6);
+      scaled_jacobian_use_straight_path(true);
+      EXPECT_LE(b.lower, g.upper);
+      EXPECT_LE(g.lower, b.upper);
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 40);
+}
+
 // The first stage's bounds `stage` of element e enclose sj(E): lower <= upper, lower never
 // above the full certified upper bound nor the sampled minimum (pyramids: no sampler
 // here), upper never below the full certified lower bound.

@@ -92,6 +92,44 @@ TEST(StraightSided, MarginBoundsJMinusTheFirstOrderJ) {
   }
 }
 
+// beta_c bounds the distance of column c of the Jacobian matrix (from the Lagrange
+// gradients) from the first-order element's, everywhere.
+TEST(StraightSided, BetaBoundsTheColumnsDistanceFromTheFirstOrderColumns) {
+  std::mt19937 rng(14);
+  for (const ElementType* type : straight_types()) {
+    const StraightSidedMargin straight(*type, jacobian_space(*type), true);
+    const ElementType& lin = first_order(*type);
+    const auto points = test::dense_points(type->family, 6, 100, rng);
+    const auto columns = [](const ElementType& t, const std::vector<double>& x, const RefPoint& p) {
+      const LagrangeBasis& b = lagrange_basis(t);
+      std::vector<double> g(static_cast<std::size_t>(3 * b.num_nodes()));
+      b.evaluate_gradients(p, g);
+      std::array<std::array<double, 3>, 3> c{};
+      for (std::size_t i = 0; i < static_cast<std::size_t>(b.num_nodes()); ++i)
+        for (std::size_t d = 0; d < 3; ++d)
+          for (std::size_t j = 0; j < 3; ++j) c[d][j] += g[3 * i + d] * x[3 * i + j];
+      return c;
+    };
+    double worst_ratio = 0;
+    for (int e = 0; e < 10; ++e) {
+      const std::vector<double> x = straight_element(*type, 0.15, 2e-10, rng);
+      std::array<double, 3> beta{};
+      ASSERT_TRUE(std::isfinite(straight.margin(x.data(), beta))) << type->name;
+      const std::vector<double> vertices(x.begin(), x.begin() + 3 * lin.num_nodes);
+      for (const RefPoint& p : points) {
+        const auto c = columns(*type, x, p), c1 = columns(lin, vertices, p);
+        for (std::size_t d = 0; d < static_cast<std::size_t>(type->dim); ++d) {
+          const double dist = std::hypot(c[d][0] - c1[d][0], c[d][1] - c1[d][1], c[d][2] - c1[d][2]);
+          const double slack = 1e-13 * std::hypot(c1[d][0], c1[d][1], c1[d][2]);  // the samples' rounding
+          EXPECT_LE(dist, beta[d] + slack) << type->name << " column " << d;
+          worst_ratio = std::max(worst_ratio, dist / beta[d]);
+        }
+      }
+    }
+    EXPECT_GT(worst_ratio, 1e-3) << type->name;
+  }
+}
+
 TEST(StraightSided, CurvedOrNonFiniteElementsGetNoMargin) {
   std::mt19937 rng(12);
   constexpr double kInf = std::numeric_limits<double>::infinity();
