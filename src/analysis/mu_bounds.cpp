@@ -5,7 +5,10 @@
 #include "quadval/mu_bounds.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <queue>
 #include <vector>
 
@@ -14,6 +17,7 @@
 #include "analysis/mu_metric.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/error.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -106,6 +110,54 @@ bool handled_family(ElementFamily f) {
   }
 }
 
+// A straight-sided simplex (tetrahedron; triangle in a plane z = const; straight_sided.hpp):
+// its columns are the edges a_c = x_c - x_0 within beta_c everywhere, so W = J_p Jinv lies
+// entrywise within delta = max_j sum_c |Jinv_cj| (beta_c + 8u max|a_c|) (the edges' and the
+// products' roundings, with a margin) of W_0 = [a] Jinv computed, which mu_constant.hpp
+// bounds in closed form, without W's control values. W_0 is written to every control value
+// of `w` (the layout those functions read). Nothing when not such a simplex, or when the
+// bounds are wider than tol.
+std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span<const double> x, double* w,
+                                                 double tol) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  constexpr double kUnit = 0x1p-53;
+  const ElementType& type = space.type();
+  const bool simplex = type.family == ElementFamily::tetrahedron ||
+                       (type.family == ElementFamily::triangle && in_a_z_plane(x));
+  if (!simplex) return std::nullopt;
+  std::array<double, 3> beta{0, 0, 0};
+  if (type.order > 1 && !(straight_sided_margin(type).margin(x.data(), beta) < kInf)) return std::nullopt;
+  const auto dim = static_cast<std::size_t>(type.dim);
+  double a[3][3] = {}, a_max[3] = {0, 0, 0};
+  for (std::size_t c = 0; c < dim; ++c)
+    for (std::size_t j = 0; j < 3; ++j) {
+      a[c][j] = x[3 * (c + 1) + j] - x[j];
+      a_max[c] = std::max(a_max[c], std::abs(a[c][j]));
+    }
+  const auto& jinv = space.ideal_inverse();
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  double delta = 0;
+  for (std::size_t j = 0; j < dim; ++j) {
+    double d = 0;
+    for (std::size_t c = 0; c < dim; ++c) d += std::abs(jinv[c * 3 + j]) * (beta[c] + 8 * kUnit * a_max[c]);
+    delta = std::max(delta, d);
+    for (std::size_t k = 0; k < 3; ++k) {
+      double v = 0;
+      for (std::size_t c = 0; c < dim; ++c) v += jinv[c * 3 + j] * a[c][k];
+      std::fill_n(w + (j * 3 + k) * ws, ws, v);
+    }
+  }
+  delta = next_up(delta * (1 + 1e-12));
+  if (!(delta < kInf)) return std::nullopt;
+  double eigenvectors[9];
+  QualityBounds out;
+  out.lower = sqrt_down(constant_ratio_lower(space, w, delta, eigenvectors));
+  out.upper = sqrt_up(corner_ratio_upper_at(space, w, delta, space.w_basis().vertex_indices()[0], eigenvectors));
+  out.tolerance_met = out.upper - out.lower <= tol;
+  if (!out.tolerance_met) return std::nullopt;
+  return out;
+}
+
 }  // namespace
 
 void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
@@ -156,6 +208,8 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   auto& free_slots = scratch.free_slots;
   free_slots.clear();
   pool.resize(block);
+  if (validity == Validity::valid && mu_constant_path_enabled())
+    if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol)) return *straight;
   const double err0 = element_w(space, nodes, pool.data());
   // Constant W (straight-sided simplices, parallelograms, parallelepipeds): W's control
   // values agree to 1e-9 relative. Then one corner's upper bound serves for all (they

@@ -405,15 +405,6 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
 
 thread_local bool use_straight_path = true;
 
-// The straight-sided margin of a simplex type, built once per thread (straight_sided.hpp).
-const StraightSidedMargin& straight_margin_of(const ElementType& type) {
-  thread_local std::vector<std::pair<const ElementType*, std::unique_ptr<const StraightSidedMargin>>> cache;
-  for (const auto& [key, margin] : cache)
-    if (key == &type) return *margin;
-  cache.emplace_back(&type, std::make_unique<const StraightSidedMargin>(type, jacobian_space(type), true));
-  return *cache.back().second;
-}
-
 // A valid straight-sided simplex (planar triangle, tetrahedron; order 1, or higher with a
 // finite straight_sided.hpp margin): its columns are the edges a_c = x_c - x_0 up to beta_c
 // (0 at order 1) and J is J_1 up to the margin m, so on the whole element each frame's
@@ -426,12 +417,12 @@ const StraightSidedMargin& straight_margin_of(const ElementType& type) {
 std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& space, std::span<const double> x,
                                                      bool planar, double tol) {
   const ElementType& type = space.type();
-  const bool triangle = type.family == ElementFamily::triangle && planar;
+  const bool triangle = type.family == ElementFamily::triangle && planar && in_a_z_plane(x);
   if (!use_straight_path || !(triangle || type.family == ElementFamily::tetrahedron)) return std::nullopt;
   std::array<double, 3> beta{0, 0, 0};
   double m = 0;
   if (type.order > 1) {
-    m = straight_margin_of(type).margin(x.data(), beta);
+    m = straight_sided_margin(type).margin(x.data(), beta);
     if (!(m < kInf)) return std::nullopt;
   }
   const LinearKind kind = triangle ? LinearKind::triangle : LinearKind::tetrahedron;

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <utility>
 
 #include "analysis/jacobian_product.hpp"
 #include "analysis/outward_rounding.hpp"
@@ -192,6 +194,20 @@ void StraightSidedMargin::margins(const double* nodes, std::size_t count, double
   std::size_t e = 0;
   for (; e + kLanes <= count; e += kLanes) lane_margins<kLanes>(nodes + e * stride, out + e);
   for (; e < count; ++e) lane_margins<1>(nodes + e * stride, out + e);
+}
+
+const StraightSidedMargin& straight_sided_margin(const ElementType& type) {
+  thread_local std::vector<std::pair<const ElementType*, std::unique_ptr<const StraightSidedMargin>>> cache;
+  for (const auto& [key, margin] : cache)
+    if (key == &type) return *margin;
+  cache.emplace_back(&type, std::make_unique<const StraightSidedMargin>(type, jacobian_space(type), true));
+  return *cache.back().second;
+}
+
+bool in_a_z_plane(std::span<const double> nodes) noexcept {
+  for (std::size_t i = 2; i < nodes.size(); i += 3)
+    if (nodes[i] != nodes[2]) return false;
+  return true;
 }
 
 }  // namespace quadval

@@ -34,6 +34,7 @@
 // first-order element to about 1e-9 of J.
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include "analysis/jacobian_space.hpp"
@@ -79,5 +80,13 @@ class StraightSidedMargin {
   std::array<double, 3> lambda_{0, 0, 0};  // Lambda_c, rounded up
   double deviation_error_ = 0;             // see straight_sided.cpp
 };
+
+/// The margin of `type` for 2D elements in a plane z = const (x, y only) and 3D elements,
+/// built once per thread (for the quality measures, element by element).
+const StraightSidedMargin& straight_sided_margin(const ElementType& type);
+
+/// True when every node of the element has the z of node 0 (a 2D element in a plane
+/// z = const, where the 2D margin holds).
+bool in_a_z_plane(std::span<const double> nodes) noexcept;
 
 }  // namespace quadval

@@ -11,7 +11,9 @@
 #include "analysis/mu_space.hpp"
 #include "mu_test_util.hpp"
 #include "quadval/element_type.hpp"
+#include "quadval/lagrange_basis.hpp"
 #include "quadval/mu_bounds.hpp"
+#include "jacobian_test_util.hpp"
 
 namespace quadval {
 namespace {
@@ -100,6 +102,40 @@ TEST(MuConstant, AffineElementsMatchSvdAndTheGeneralPath) {
   }
   // The closed form settled (nearly) all of them, to far better than the tolerance.
   EXPECT_GT(fast, 4000);
+}
+
+TEST(MuConstant, StraightSidedSimplicesWithTinyDeviations) {
+  // Straight simplices of orders 2-4 whose high-order nodes are 1e-10 off their straight
+  // positions: the straight-sided closed form (mu_bounds.cpp, straight_sided.hpp margins)
+  // holds every sampled pointwise mu above its lower bound and overlaps the general path.
+  std::mt19937 rng(6);
+  std::uniform_real_distribution<double> u(-1, 1);
+  QualityOptions opt;
+  opt.abs_tol = 1e-6;
+  for (const int id : {9, 21, 23, 11, 29}) {  // triangles of orders 2-4, tetrahedra 2-3
+    const ElementType& type = *find_element_type(id);
+    const LagrangeBasis& basis = lagrange_basis(type);
+    const auto points = test::dense_points(type.family, 6, 50, rng);
+    for (int e = 0; e < 20; ++e) {
+      Eigen::Matrix3d a = Eigen::Matrix3d::Identity();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) a(i, j) += 0.6 * u(rng);
+      if (type.dim == 2) a(0, 2) = a(1, 2) = a(2, 0) = a(2, 1) = 0, a(2, 2) = 1;
+      if (a.determinant() < 0.05) continue;
+      auto x = test::affine_ideal_element(type, a, Eigen::Vector3d(u(rng), u(rng), type.dim == 2 ? 0.0 : u(rng)));
+      for (std::size_t i = 3 * static_cast<std::size_t>(type.dim + 1); i < x.size(); ++i)
+        if (!(type.dim == 2 && i % 3 == 2)) x[i] += 1e-10 * u(rng);
+      const QualityBounds q = mu_bounds(type, x, opt, true);
+      mu_use_constant_path(false);
+      const QualityBounds g = mu_bounds(type, x, opt, true);
+      mu_use_constant_path(true);
+      const test::SampledMu sampled = test::sample_mu(basis, x, points);
+      EXPECT_TRUE(q.tolerance_met) << type.name << " element " << e;
+      EXPECT_LE(q.lower, sampled.lo * (1 + 1e-12)) << type.name << " element " << e;
+      EXPECT_LE(q.lower, g.upper) << type.name << " element " << e;
+      EXPECT_LE(g.lower, q.upper) << type.name << " element " << e;
+    }
+  }
 }
 
 TEST(MuConstant, CurvedElementsAreNotTakenForConstant) {
