@@ -184,21 +184,27 @@ BENCHMARK(BM_CheckCurvedType)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
-// check as `quadval check FILE -q` runs it (streamed, summary only) on each curved mesh of
-// ../shared/data, the meshes of bench/compare_gmsh_check.py: small ones, where fixed and
-// per-element costs show. The shared folder is $QUADVAL_SHARED_DIR, else ../shared beside the
-// repository; an error row when a file is absent.
-void BM_CheckSharedCurved(benchmark::State& state, const std::string& name) {
+// A curved mesh of ../shared/data: the shared folder is $QUADVAL_SHARED_DIR, else ../shared
+// beside the repository; false (an error row) when the file cannot be read.
+bool read_shared_curved(benchmark::State& state, const std::string& name, Mesh& mesh) {
   const char* env = std::getenv("QUADVAL_SHARED_DIR");
   const std::string dir =
       env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
-  Mesh mesh;
   try {
     mesh = read_mesh(dir + "/data/curved/" + name + ".msh");
   } catch (const std::exception& e) {
     state.SkipWithError(e.what());
-    return;
+    return false;
   }
+  return true;
+}
+
+// check as `quadval check FILE -q` runs it (streamed, summary only) on each curved mesh of
+// ../shared/data, the meshes of bench/compare_gmsh_check.py: small ones, where fixed and
+// per-element costs show.
+void BM_CheckSharedCurved(benchmark::State& state, const std::string& name) {
+  Mesh mesh;
+  if (!read_shared_curved(state, name, mesh)) return;
   CheckOptions o;
   o.threads = static_cast<int>(state.range(0));
   for (auto _ : state)
@@ -206,19 +212,12 @@ void BM_CheckSharedCurved(benchmark::State& state, const std::string& name) {
   state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
                                                     benchmark::Counter::kIsIterationInvariantRate);
 }
+
 // The quality measures of `check` (mu, the scaled Jacobian; validity included) on a shared
 // mesh, one thread, at the CLI's default tolerance: Arg 0 mu, 1 the scaled Jacobian.
 void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
-  const char* env = std::getenv("QUADVAL_SHARED_DIR");
-  const std::string dir =
-      env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
   Mesh mesh;
-  try {
-    mesh = read_mesh(dir + "/data/curved/" + name + ".msh");
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
+  if (!read_shared_curved(state, name, mesh)) return;
   CheckOptions o;
   o.threads = 1;
   o.measure = state.range(0) == 0 ? CheckMeasure::mu : CheckMeasure::scaled_jacobian;
@@ -232,16 +231,8 @@ void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
 // their error bounds) over the first block of a shared mesh, in chunks of 64 as `check`
 // calls it; the nodes are gathered once, outside the timing.
 void BM_JacobianProductKernel(benchmark::State& state, const std::string& name) {
-  const char* env = std::getenv("QUADVAL_SHARED_DIR");
-  const std::string dir =
-      env ? env : (std::filesystem::path(__FILE__).parent_path() / ".." / ".." / "shared").string();
   Mesh mesh;
-  try {
-    mesh = read_mesh(dir + "/data/curved/" + name + ".msh");
-  } catch (const std::exception& e) {
-    state.SkipWithError(e.what());
-    return;
-  }
+  if (!read_shared_curved(state, name, mesh)) return;
   const ElementBlock& blk = mesh.blocks.front();
   const JacobianSpace& space = jacobian_space(*blk.type);
   const auto nn = static_cast<std::size_t>(blk.type->num_nodes);

@@ -32,6 +32,7 @@
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
 #include "analysis/jacobian_samples.hpp"
+#include "analysis/lane_vector.hpp"
 #include "analysis/product_tables.hpp"
 #include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
@@ -46,21 +47,6 @@ namespace {
 using MultiIndex = std::array<int, 4>;
 constexpr double kUnit = 0x1p-53;
 
-// W doubles, one per lane, held in one register (a GCC vector: each operation is the
-// scalar one on every lane, so lane l computes what an element computed alone does).
-template <int W>
-struct LaneVector {
-  typedef double Type __attribute__((vector_size(8 * W)));
-};
-template <int W>
-using Lanes = typename LaneVector<W>::Type;
-
-template <int W>
-Lanes<W> load_lanes(const double* p) {
-  Lanes<W> v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
 
 int index_of(const std::vector<MultiIndex>& list, const MultiIndex& a) {
   const auto it = std::find(list.begin(), list.end(), a);

@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "analysis/jacobian_product.hpp"
+#include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "quadval/lagrange_basis.hpp"
 
@@ -19,14 +20,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kStraight = 1e-9;  // deviation / edge below which an element counts as straight
 constexpr double kUnderflow = 0x1p-1000;
 
-// W doubles side by side (GCC vector extension): the same IEEE operations lane by lane.
-constexpr int kLanes = 8;
-template <int W>
-struct LaneVector {
-  typedef double Type __attribute__((vector_size(8 * W)));
-};
-template <int W>
-using Lanes = typename LaneVector<W>::Type;
+constexpr int kLanes = 8;  // elements side by side (lane_vector.hpp)
 template <class V>
 V vabs(V a) { return a < 0 ? -a : a; }
 template <class V>
