@@ -146,16 +146,15 @@ void StraightSidedMargin::lane_margins(const double* nodes, double* out, double*
   for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) {
     for (int k = 0; k < dirs[c].edges; ++k) {
       const auto from = static_cast<std::size_t>(dirs[c].from[k]), to = static_cast<std::size_t>(dirs[c].to[k]);
-      V norm = {};
-      for (std::size_t j = 0; j < axes; ++j) norm += vabs((to == 0 ? V{} : y[to][j]) - (from == 0 ? V{} : y[from][j]));
+      V norm = {};  // from the coordinates: one rounding per component, however far from x_0
+      for (std::size_t j = 0; j < axes; ++j) norm += vabs(at(to, j) - at(from, j));
       alpha[c] = vmax(alpha[c], norm);
       finite += norm;
     }
     edge = vmax(edge, alpha[c]);
     alpha[c] *= half * (1 + 1e-12);
   }
-  // y_to - y_from = x_to - x_from up to the roundings of y (2u relative to |y|), which the
-  // factor 1 + 1e-12 covers with the 1-norm's own.
+  // The differences' and the 1-norms' roundings (a few u relative) are covered by 1 + 1e-12.
   V beta[3] = {};
   for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) beta[c] = lambda_[c] * delta * (1 + 1e-12);
   // prod (alpha + beta) - prod alpha, as a sum of nonnegative terms.

@@ -57,8 +57,8 @@ class StraightSidedMargin {
   void margins(const double* nodes, std::size_t count, double* out) const noexcept;
 
   /// One element: its margin as above and beta_c >= |D_c| everywhere, the distance of
-  /// column c of the Jacobian matrix from the first-order element's (beta is left as is
-  /// where the margin is +inf).
+  /// column c of the Jacobian matrix from the first-order element's (meaningless where the
+  /// margin is +inf).
   double margin(const double* nodes, std::array<double, 3>& beta) const noexcept;
 
  private:
