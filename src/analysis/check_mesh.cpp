@@ -464,14 +464,19 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (const StraightSidedMargin* straight = straight_of[ch.block].get()) {
                 const std::uint64_t ts = stage_ticks();
                 const auto nv = static_cast<std::size_t>(linear_num_vertices(straight->kind()));
-                soa.resize(nv * 3 * kLinearChunk);
                 margins.resize(kLinearChunk);
                 straight->margins(nodes.data(), ch.count, margins.data());
-                for (std::size_t i = 0; i < ch.count; ++i)
-                  for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearChunk + i] = nodes[i * nn * 3 + k];
-                fast_bounds.resize(ch.count);
-                linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
-                                      margins.data());
+                if (std::any_of(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(ch.count),
+                                [](double m) { return std::isfinite(m); })) {
+                  soa.resize(nv * 3 * kLinearChunk);
+                  for (std::size_t i = 0; i < ch.count; ++i)
+                    for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearChunk + i] = nodes[i * nn * 3 + k];
+                  fast_bounds.resize(ch.count);
+                  linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
+                                        margins.data());
+                } else {
+                  std::fill(decided, decided + ch.count, false);  // a chunk of curved elements
+                }
                 const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
                 for (std::size_t i = 0; i < ch.count; ++i) {
                   if (!decided[i]) {

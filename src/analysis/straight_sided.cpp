@@ -120,9 +120,26 @@ void StraightSidedMargin::lane_margins(const double* nodes, double* out, double*
       y[v][j] = at(v, j) - x0[j];
       vertex_sum[j] += vabs(y[v][j]);
     }
+  // alpha_c: the largest 1-norm of the edges of direction c (halved on [-1, 1]).
+  const Direction* dirs = directions(kind_);
+  const double half = kind_ == LinearKind::triangle || kind_ == LinearKind::tetrahedron ? 1.0 : 0.5;
+  V alpha[3] = {}, edge = {}, finite = {};
+  for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) {
+    for (int k = 0; k < dirs[c].edges; ++k) {
+      const auto from = static_cast<std::size_t>(dirs[c].from[k]), to = static_cast<std::size_t>(dirs[c].to[k]);
+      V norm = {};  // from the coordinates: one rounding per component, however far from x_0
+      for (std::size_t j = 0; j < axes; ++j) norm += vabs(at(to, j) - at(from, j));
+      alpha[c] = vmax(alpha[c], norm);
+      finite += norm;
+    }
+    edge = vmax(edge, alpha[c]);
+    alpha[c] *= half * (1 + 1e-12);
+  }
   // The largest deviation and the largest |y| of the other nodes, per axis; `finite` sums
   // the deviations, so that a NaN or infinite coordinate (which max would drop) shows.
-  V deviation[3] = {}, largest[3] = {}, finite = {};
+  // Curved elements stop at the first node that shows every lane curved.
+  const V limit = kStraight * edge;
+  V deviation[3] = {}, largest[3] = {};
   for (std::size_t i = nv; i < nn; ++i) {
     const NodeTerms& t = terms_[i - nv];
     for (std::size_t j = 0; j < axes; ++j) {
@@ -135,25 +152,17 @@ void StraightSidedMargin::lane_margins(const double* nodes, double* out, double*
       largest[j] = vmax(largest[j], vabs(yi));
       finite += d;
     }
+    const V shown = deviation[0] + deviation[1] + deviation[2];
+    bool all_curved = true;
+    for (std::size_t l = 0; l < W && all_curved; ++l) all_curved = shown[l] > limit[l];
+    if (all_curved) {
+      std::fill(out, out + W, kInf);
+      return;
+    }
   }
   V delta = {};
   for (std::size_t j = 0; j < axes; ++j)
     delta += deviation[j] + deviation_error_ * (largest[j] + vertex_sum[j]) + kUnderflow;
-  // alpha_c: the largest 1-norm of the edges of direction c (halved on [-1, 1]).
-  const Direction* dirs = directions(kind_);
-  const double half = kind_ == LinearKind::triangle || kind_ == LinearKind::tetrahedron ? 1.0 : 0.5;
-  V alpha[3] = {}, edge = {};
-  for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) {
-    for (int k = 0; k < dirs[c].edges; ++k) {
-      const auto from = static_cast<std::size_t>(dirs[c].from[k]), to = static_cast<std::size_t>(dirs[c].to[k]);
-      V norm = {};  // from the coordinates: one rounding per component, however far from x_0
-      for (std::size_t j = 0; j < axes; ++j) norm += vabs(at(to, j) - at(from, j));
-      alpha[c] = vmax(alpha[c], norm);
-      finite += norm;
-    }
-    edge = vmax(edge, alpha[c]);
-    alpha[c] *= half * (1 + 1e-12);
-  }
   // The differences' and the 1-norms' roundings (a few u relative) are covered by 1 + 1e-12.
   V beta[3] = {};
   for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) beta[c] = lambda_[c] * delta * (1 + 1e-12);
