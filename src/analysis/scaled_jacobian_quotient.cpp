@@ -157,15 +157,11 @@ class Quotient {
   Quotient(const ScaledJacobianSpace& space, const QuotientInput& in)
       : space_(space), in_(in), layout_(layout_of(space, in)) {
     dim_ = static_cast<std::size_t>(space.dim());
-    j_tools_ = layout_.j_tools;
-    col_tools_ = layout_.col_tools;
-    offset_ = layout_.offset;
-    size_ = layout_.size;
-    stride_ = layout_.stride;
-    QV_ASSERT(offset_[1] == in.j.size() && size_[0] == in.col[0][0].size(), "the layout of another input");
+    QV_ASSERT(layout_.offset[1] == in.j.size() && layout_.size[0] == in.col[0][0].size(),
+              "the layout of another input");
   }
 
-  std::size_t stride() const { return stride_; }
+  std::size_t stride() const { return layout_.stride; }
 
   // The root leaf, into `leaf` (stride() doubles) and its errors.
   void root(double* leaf, std::array<double, 4>& err) const {
@@ -173,7 +169,7 @@ class Quotient {
     err[0] = in_.j_error;
     for (std::size_t c = 0; c < dim_; ++c) {
       for (std::size_t x = 0; x < 3; ++x)
-        std::copy(in_.col[c][x].begin(), in_.col[c][x].end(), leaf + offset_[c + 1] + x * size_[c]);
+        std::copy(in_.col[c][x].begin(), in_.col[c][x].end(), leaf + layout_.offset[c + 1] + x * layout_.size[c]);
       err[c + 1] = in_.col_error[c];
     }
   }
@@ -183,7 +179,7 @@ class Quotient {
   double bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
     const std::size_t sj = in_.j.size();
     const double j_lo = down(*std::min_element(leaf, leaf + sj) - err[0]);
-    const std::vector<int>& j_corners = j_tools_->corners;
+    const std::vector<int>& j_corners = layout_.j_tools->corners;
     const std::size_t corners = j_corners.size();
     // Each distinct frame column: the squared norms of its control points, their largest,
     // and the spread of its norms from the columns' errors.
@@ -202,7 +198,7 @@ class Quotient {
       }
       spread_[d] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
       col0_[d] = static_cast<std::size_t>(f.column[0]);
-      const std::size_t n = size_[col0_[d]];
+      const std::size_t n = layout_.size[col0_[d]];
       first_[d] = sumsq_.size();
       double big = 0;
       for (std::size_t i = 0; i < n; ++i) {
@@ -211,7 +207,7 @@ class Quotient {
           double v = 0;
           for (int t = 0; t < f.terms; ++t) {
             const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-            v += f.weight[static_cast<std::size_t>(t)] * leaf[offset_[c + 1] + x * n + i];
+            v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + i];
           }
           sum += v * v;
         }
@@ -231,7 +227,7 @@ class Quotient {
       // bound; the estimate only picks a sharp one), then certified there.
       const auto square_at = [&](std::size_t j, std::size_t m) {
         const std::size_t d = fr[j];
-        return sumsq_[first_[d] + static_cast<std::size_t>(col_tools_[col0_[d]]->corners[m])];
+        return sumsq_[first_[d] + static_cast<std::size_t>(layout_.col_tools[col0_[d]]->corners[m])];
       };
       std::size_t best = corners;
       double best_square = kInf;
@@ -262,9 +258,9 @@ class Quotient {
   void split(const double* leaf, const std::array<double, 4>& err, const BisectionState& state,
              std::vector<double>& children, std::vector<BisectionState>& states,
              std::array<double, 4>& child_err) const {
-    const BernsteinBisection& jb = *j_tools_->bisection;
+    const BernsteinBisection& jb = *layout_.j_tools->bisection;
     const auto nc = static_cast<std::size_t>(jb.num_children());
-    children.resize(nc * stride_);
+    children.resize(nc * layout_.stride);
     states.resize(nc);
     const auto child_error = [](const BernsteinBisection& b, double e, const double* v, std::size_t n) {
       double m = 0;
@@ -272,33 +268,29 @@ class Quotient {
       return up((e + b.rounding_relative() * m + b.rounding_absolute()) * (1 + 1e-12));
     };
     const std::size_t sj = in_.j.size();
-    part_.resize(nc * stride_);  // any one part's children: stride_ >= J's and 3 x a column's size
+    part_.resize(nc * layout_.stride);  // any one part's children: layout_.stride >= J's and 3 x a column's size
     jb.split(leaf, 1, state, part_.data(), states.data(), scratch_);
-    for (std::size_t q = 0; q < nc; ++q) std::copy_n(part_.data() + q * sj, sj, children.data() + q * stride_);
+    for (std::size_t q = 0; q < nc; ++q) std::copy_n(part_.data() + q * sj, sj, children.data() + q * layout_.stride);
     child_err[0] = child_error(jb, err[0], leaf, sj);
     for (std::size_t c = 0; c < dim_; ++c) {
-      const BernsteinBisection& cb = *col_tools_[c]->bisection;
-      const std::size_t block = 3 * size_[c];
-      const double* parent = leaf + offset_[c + 1];
+      const BernsteinBisection& cb = *layout_.col_tools[c]->bisection;
+      const std::size_t block = 3 * layout_.size[c];
+      const double* parent = leaf + layout_.offset[c + 1];
       column_states_.resize(nc);
       cb.split(parent, 3, state, part_.data(), column_states_.data(), scratch_);
       for (std::size_t q = 0; q < nc; ++q)
-        std::copy_n(part_.data() + q * block, block, children.data() + q * stride_ + offset_[c + 1]);
+        std::copy_n(part_.data() + q * block, block, children.data() + q * layout_.stride + layout_.offset[c + 1]);
       child_err[c + 1] = child_error(cb, err[c + 1], parent, block);
     }
   }
 
-  BisectionState root_state() const { return j_tools_->bisection->root_state(); }
+  BisectionState root_state() const { return layout_.j_tools->bisection->root_state(); }
 
  private:
   const ScaledJacobianSpace& space_;
   const QuotientInput& in_;
   const QuotientLayout& layout_;
-  std::size_t dim_ = 0, stride_ = 0;
-  const SpaceTools* j_tools_ = nullptr;
-  std::array<const SpaceTools*, 3> col_tools_{};
-  std::array<std::size_t, 4> offset_{};  // of J (0) and of column c (c + 1) in a leaf
-  std::array<std::size_t, 3> size_{};    // coefficients of column c, per coordinate
+  std::size_t dim_ = 0;
   const double gamma_ = rounding_gamma(6);  // of a frame column's sum of <= 3 columns
   mutable std::vector<double> sumsq_, part_, scratch_, big_, spread_;
   mutable std::vector<std::size_t> first_, col0_;

@@ -26,16 +26,12 @@ V vabs(V a) { return a < 0 ? -a : a; }
 template <class V>
 V vmax(V a, V b) { return a < b ? b : a; }
 
-// The first-order kind of a curved type's vertices.
+// The first-order kind of a curved type's vertices (pyramids excluded: Bergot's
+// first-order map is not in the space of the higher orders' maps).
 LinearKind vertex_kind(const ElementType& type, bool planar) noexcept {
-  if (type.order < 2 || !type.has_lagrange_basis) return LinearKind::none;
-  switch (type.family) {
-    case ElementFamily::triangle: return planar ? LinearKind::triangle : LinearKind::none;
-    case ElementFamily::quadrangle: return planar ? LinearKind::quadrangle : LinearKind::none;
-    case ElementFamily::tetrahedron: return LinearKind::tetrahedron;
-    case ElementFamily::hexahedron: return LinearKind::hexahedron;
-    default: return LinearKind::none;  // pyramids: Bergot's first-order map is not polynomial
-  }
+  if (type.order < 2 || !type.has_lagrange_basis || type.family == ElementFamily::pyramid) return LinearKind::none;
+  const ElementType* first_order = find_element_type(type.family, 1, true);
+  return first_order != nullptr ? linear_kind(*first_order, planar) : LinearKind::none;
 }
 
 // Per direction c, the vertex pairs (from, to) of the edges whose convex combination is
