@@ -59,10 +59,10 @@ void bm_linear_chunk(benchmark::State& state, ElementFamily family) {
   const LinearKind kind = linear_kind(type, false);
   const auto nv = static_cast<std::size_t>(linear_num_vertices(kind));
   const auto elements = random_elements(type, static_cast<int>(kLinearChunk));
-  std::vector<double> soa(nv * 3 * kLinearChunk);
+  std::vector<double> soa(nv * 3 * kLinearRow);
   for (std::size_t e = 0; e < kLinearChunk; ++e)
     for (std::size_t v = 0; v < nv; ++v)
-      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearChunk + e] = elements[e][v * 3 + a];
+      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearRow + e] = elements[e][v * 3 + a];
   std::vector<JacobianBounds> out(kLinearChunk);
   bool decided[kLinearChunk];
   for (auto _ : state) {

@@ -157,6 +157,11 @@ class WorstList {
  public:
   explicit WorstList(std::size_t capacity = 10) : capacity_(capacity) {}
   void offer(const WorstElement& e);
+  /// False only when an element of this key cannot enter the list (it is full and its
+  /// highest key is lower): a test before building the element, on every element.
+  bool may_take(double key) const noexcept {
+    return heap_.size() < capacity_ || !(key > heap_.front().key);
+  }
   /// The kept elements, lowest first.
   std::vector<WorstElement> sorted() const;
   std::size_t capacity() const noexcept { return capacity_; }

@@ -178,6 +178,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
 
   const bool want_mu = measures_mu(options.measure);
   const bool want_sj = measures_scaled_jacobian(options.measure);
+  const bool want_distortion = measures_distortion(options.measure);
   QualityOptions qo;
   qo.abs_tol = options.quality_abs_tol;
   qo.max_subdivisions = options.max_subdivisions;
@@ -394,7 +395,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               ElementCheck& ec = elements[index];
               ec.analysed = true;
               const JacobianBounds& b = ec.bounds;
-              if (measures_distortion(options.measure))
+              if (want_distortion)
                 distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws, bo);
               if (want_mu)
                 quality(mu_supported(type), mu[index], st.mu, xe,
@@ -412,12 +413,17 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // the vertices; the few it leaves open go one by one to the general path.
               const std::uint64_t ts = stage_ticks();
               const auto nv = static_cast<std::size_t>(linear_num_vertices(fast));
-              soa.resize(nv * 3 * kLinearChunk);
+              soa.resize(nv * 3 * kLinearRow);
+              const double* coords = mesh.coords.data();
               for (std::size_t i = 0; i < ch.count; ++i) {
-                const auto conn = blk.element(ch.first + i);
-                for (std::size_t k = 0; k < nv; ++k)
-                  for (std::size_t j = 0; j < 3; ++j)
-                    soa[(k * 3 + j) * kLinearChunk + i] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+                const NodeIndex* conn = blk.element(ch.first + i).data();
+                double* to = soa.data() + i;
+                for (std::size_t k = 0; k < nv; ++k) {
+                  const double* x = coords + 3 * static_cast<std::size_t>(conn[k]);
+                  to[(k * 3) * kLinearRow] = x[0];
+                  to[(k * 3 + 1) * kLinearRow] = x[1];
+                  to[(k * 3 + 2) * kLinearRow] = x[2];
+                }
               }
               fast_bounds.resize(ch.count);
               linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
@@ -468,9 +474,9 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 straight->margins(nodes.data(), ch.count, margins.data());
                 if (std::any_of(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(ch.count),
                                 [](double m) { return std::isfinite(m); })) {
-                  soa.resize(nv * 3 * kLinearChunk);
+                  soa.resize(nv * 3 * kLinearRow);
                   for (std::size_t i = 0; i < ch.count; ++i)
-                    for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearChunk + i] = nodes[i * nn * 3 + k];
+                    for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearRow + i] = nodes[i * nn * 3 + k];
                   fast_bounds.resize(ch.count);
                   linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
                                         margins.data());
@@ -514,7 +520,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // One clock read per element when `finish` is only bookkeeping (its time then
               // counts in the next element's stage); mu, the scaled Jacobian and distortion
               // in `finish` are kept out of the stage times.
-              const bool light_finish = !want_mu && !want_sj && !measures_distortion(options.measure);
+              const bool light_finish = !want_mu && !want_sj && !want_distortion;
               for (std::size_t k = 0; k < left; ++k) {
                 const std::size_t i = rest[k];
                 ElementCheck& ec = elements[ch.out + i];

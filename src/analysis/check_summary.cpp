@@ -114,19 +114,24 @@ CheckSummary empty_summary(const std::string& file, CheckMeasure measure, std::s
 }
 
 void add_elements(CheckSummary& s, const CheckBatch& b, std::size_t from, std::size_t to) {
-  const bool mu = measures_mu(s.measure), sj = measures_scaled_jacobian(s.measure);
+  const bool by_distortion = measures_distortion(s.measure);
   for (std::size_t i = from; i < to; ++i) {
     const ElementCheck& e = b.elements[i];
-    const std::size_t index = b.first + i;
-    if (e.analysed) {
-      const double q = quality_key(s.measure, e, b.distortion_of(i));
-      s.histogram.add(q);
-      s.worst.offer(worst_entry(index, e, q));
-    }
-    for (auto [on, bounds, summary] : {std::tuple{mu, b.mu_of(i), &s.mu}, std::tuple{sj, b.sj_of(i), &s.sj}}) {
-      if (!on || std::isnan(bounds.lower)) continue;
+    if (!e.analysed) continue;
+    const double q = by_distortion ? b.distortion_of(i).lower : e.ratio_lower();
+    s.histogram.add(q);
+    if (s.worst.may_take(q)) s.worst.offer(worst_entry(b.first + i, e, q));
+  }
+  // mu and sj are computed for analysed elements only (NaN otherwise).
+  for (auto [values, summary] : {std::pair{b.mu, &s.mu}, std::pair{b.sj, &s.sj}}) {
+    if (values.empty() || !(summary == &s.mu ? measures_mu(s.measure) : measures_scaled_jacobian(s.measure)))
+      continue;
+    for (std::size_t i = from; i < to; ++i) {
+      const QualityBounds& bounds = values[i];
+      if (std::isnan(bounds.lower)) continue;
       summary->histogram.add(bounds.lower);
-      summary->worst.offer(worst_entry(index, e, bounds.lower, bounds));
+      if (summary->worst.may_take(bounds.lower))
+        summary->worst.offer(worst_entry(b.first + i, b.elements[i], bounds.lower, bounds));
     }
   }
 }

@@ -243,11 +243,11 @@ void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, boo
   constexpr int n = num_coefficients(kKind);
   for (std::size_t e = 0; e < count; e += kLanes) {
     const auto point = [&](int v) {
-      const double* q = soa + static_cast<std::size_t>(v) * 3 * kLinearChunk + e;
+      const double* q = soa + static_cast<std::size_t>(v) * 3 * kLinearRow + e;
       Vec3<Lanes> r;
       std::memcpy(&r.x, q, sizeof(Lanes));
-      std::memcpy(&r.y, q + kLinearChunk, sizeof(Lanes));
-      std::memcpy(&r.z, q + 2 * kLinearChunk, sizeof(Lanes));
+      std::memcpy(&r.y, q + kLinearRow, sizeof(Lanes));
+      std::memcpy(&r.z, q + 2 * kLinearRow, sizeof(Lanes));
       return r;
     };
     Lanes c[n];

@@ -81,6 +81,10 @@ int linear_num_vertices(LinearKind kind) noexcept;
 
 /// Largest chunk linear_validity_chunk accepts.
 inline constexpr std::size_t kLinearChunk = 256;
+/// Distance between the rows of its coordinates (soa below): a chunk and a cache line more,
+/// so that the rows do not map to the same few sets of the L1 cache, as rows 2 KiB apart
+/// do (an element's 24 hexahedron coordinates then evicted each other while gathered).
+inline constexpr std::size_t kLinearRow = kLinearChunk + 8;
 
 /// Bézier coefficients of J of one first-order element and their common error bound.
 /// @param nodes  #vertices x 3 coordinates, Gmsh node order
@@ -91,8 +95,8 @@ inline constexpr std::size_t kLinearChunk = 256;
 double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double* coeffs) noexcept;
 
 /// The fast validity check of a chunk of first-order elements.
-/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * kLinearChunk
-///                + e], #vertices * 3 * kLinearChunk doubles (entries e >= count are read,
+/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * kLinearRow
+///                + e], #vertices * 3 * kLinearRow doubles (entries e >= count are read,
 ///                in groups of 8, and their results dropped: any values will do)
 /// @param count   elements, at most kLinearChunk
 /// @param out     count results; out[e] is written only where decided[e]

@@ -293,10 +293,10 @@ Tally check_type(const ElementType& type, const std::vector<std::vector<double>>
   Tally t;
   for (std::size_t first = 0; first < elements.size(); first += kLinearChunk) {
     const std::size_t count = std::min(kLinearChunk, elements.size() - first);
-    std::vector<double> soa(nv * 3 * kLinearChunk);
+    std::vector<double> soa(nv * 3 * kLinearRow);
     for (std::size_t e = 0; e < count; ++e)
       for (std::size_t v = 0; v < nv; ++v)
-        for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearChunk + e] = elements[first + e][v * 3 + a];
+        for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearRow + e] = elements[first + e][v * 3 + a];
     std::vector<JacobianBounds> fast(count);
     bool decided[kLinearChunk];
     linear_validity_chunk(kind, soa.data(), count, fast.data(), decided);
@@ -437,9 +437,9 @@ TEST(LinearFastPath, AffinePyramidHasConstantJacobian) {
     const double err = linear_jacobian_coefficients(LinearKind::pyramid, x.data(), c);
     ASSERT_TRUE(std::isfinite(err));
     for (double v : c) EXPECT_LE(abs(mpq_class(v) - det), mpq_class(err)) << e;
-    std::vector<double> soa(5 * 3 * kLinearChunk);
+    std::vector<double> soa(5 * 3 * kLinearRow);
     for (std::size_t v = 0; v < 5; ++v)
-      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearChunk] = x[v * 3 + a];
+      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearRow] = x[v * 3 + a];
     JacobianBounds b;
     bool decided[1] = {false};
     linear_validity_chunk(LinearKind::pyramid, soa.data(), 1, &b, decided);
@@ -476,9 +476,9 @@ TEST(LinearFastPath, PyramidMinimumIsAtACornerValue) {
       for (int j = 0; j <= m; ++j)
         for (int k = 1; k <= m; k += 3) lattice_min = std::min(lattice_min, pyramid_jacobian_cube(*x, mpq_class(i, m), mpq_class(j, m), mpq_class(k, m)));
     EXPECT_EQ(lattice_min, cmin);  // attained at a corner, never below it
-    std::vector<double> soa(5 * 3 * kLinearChunk);
+    std::vector<double> soa(5 * 3 * kLinearRow);
     for (std::size_t v = 0; v < 5; ++v)
-      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearChunk] = (*x)[v * 3 + a];
+      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearRow] = (*x)[v * 3 + a];
     JacobianBounds b;
     bool decided[1] = {false};
     linear_validity_chunk(LinearKind::pyramid, soa.data(), 1, &b, decided);
@@ -513,10 +513,10 @@ TEST(LinearFastPath, OutsideTheGuardedRangeNothingIsDecided) {
   // does not apply, so everything goes to the general path.
   const ElementType& type = *find_element_type(5);
   for (double scale : {1e-70, 1e70}) {
-    std::vector<double> soa(8 * 3 * kLinearChunk);
+    std::vector<double> soa(8 * 3 * kLinearRow);
     const auto ref = reference_nodes(type);
     for (std::size_t v = 0; v < 8; ++v)
-      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearChunk] = scale * ref[v][a];
+      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearRow] = scale * ref[v][a];
     JacobianBounds b;
     bool decided[1] = {true};
     linear_validity_chunk(LinearKind::hexahedron, soa.data(), 1, &b, decided);
@@ -524,11 +524,11 @@ TEST(LinearFastPath, OutsideTheGuardedRangeNothingIsDecided) {
   }
   // Non-finite coordinates are never decided either.
   for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
-    std::vector<double> soa(8 * 3 * kLinearChunk);
+    std::vector<double> soa(8 * 3 * kLinearRow);
     const auto ref = reference_nodes(type);
     for (std::size_t v = 0; v < 8; ++v)
-      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearChunk] = ref[v][a];
-    soa[(6 * 3 + 1) * kLinearChunk] = bad;
+      for (std::size_t a = 0; a < 3; ++a) soa[(v * 3 + a) * kLinearRow] = ref[v][a];
+    soa[(6 * 3 + 1) * kLinearRow] = bad;
     JacobianBounds b;
     bool decided[1] = {true};
     linear_validity_chunk(LinearKind::hexahedron, soa.data(), 1, &b, decided);
@@ -562,9 +562,9 @@ TEST(LinearFastPath, ChunkBoundsAreTheDocumentedOutwardRoundedValues) {
     std::size_t decided_count = 0;
     for (std::size_t first = 0, count = 253; first < elements.size(); first += count, count = count % 256 + 1) {
       count = std::min(count, elements.size() - first);
-      std::vector<double> soa(nv * 3 * kLinearChunk, 0.5);
+      std::vector<double> soa(nv * 3 * kLinearRow, 0.5);
       for (std::size_t e = 0; e < count; ++e)
-        for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearChunk + e] = elements[first + e][k];
+        for (std::size_t k = 0; k < nv * 3; ++k) soa[k * kLinearRow + e] = elements[first + e][k];
       JacobianBounds sentinel;
       sentinel.jmin_lower = -12345;
       sentinel.stage = 99;
