@@ -408,6 +408,15 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
+            // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp):
+            // that is only on the fast path, which measures validity alone, and the chunk
+            // never takes the exact fallback, so only the bookkeeping is left.
+            const auto finish_first_order = [&](std::size_t index, const JacobianBounds& b, double ticks) {
+              ElementCheck& ec = elements[index];
+              ec.bounds = b;
+              ec.analysed = true;
+              st.add(b.stage, b.validity, ticks);
+            };
             if (fast != LinearKind::none) {
               // First-order fast path (linear_jacobian.hpp): the coefficients straight from
               // the vertices; the few it leaves open go one by one to the general path.
@@ -434,8 +443,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 ElementCheck& ec = elements[ch.out + i];
                 const auto conn = blk.element(ch.first + i);
                 if (decided[i]) {
-                  ec.bounds = fast_bounds[i];
-                  finish(ch.out + i, nullptr, share);  // no distortion: fast_path is validity only
+                  finish_first_order(ch.out + i, fast_bounds[i], share);
                   continue;
                 }
                 const std::uint64_t te = stage_ticks();
@@ -489,8 +497,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                     rest[left++] = i;
                     continue;
                   }
-                  elements[ch.out + i].bounds = fast_bounds[i];
-                  finish(ch.out + i, nodes.data() + i * nn * 3, share);
+                  finish_first_order(ch.out + i, fast_bounds[i], share);
                 }
                 // The rest's nodes to the front, in order (rest[k] >= k).
                 for (std::size_t k = 0; k < left; ++k)
