@@ -61,6 +61,7 @@ enum class TableSource {
 /// Scratch of JacobianProduct::coefficients, reused across calls.
 struct ProductScratch {
   std::vector<double> block;  // one lane block's coordinates, derivatives and cross products
+  std::vector<double> pair;   // the two lanes' coefficients of a single element
 };
 
 class JacobianProduct {
