@@ -196,6 +196,22 @@ bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& 
   return true;
 }
 
+bool ratio_at_least2(const double* m, double err, double r) {
+  // lambda = q -+ d as in symmetric_eigen_enclosure<2>, with the same radius rq of q and s
+  // over the error box; with q > 0, (q - d) >= r (q + d) iff q (1 - r) >= d (1 + r) iff
+  // q^2 (1 - r)^2 >= (s^2 + t^2) (1 + r)^2.
+  const double q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]);
+  const double rq = (err + kGamma * 0.5 * (std::abs(m[0]) + std::abs(m[1]))) * (1 + kGamma);
+  const double q_lo = next_down(q - rq);
+  if (!(q_lo > 0)) return false;
+  const double s_hi = next_up(std::abs(s) + rq), t_hi = next_up(std::abs(m[2]) + err);
+  // Each side, its factor (1 -+ kGamma) included, is within 8 roundings of its exact
+  // value: gamma_16 on both sides covers them.
+  const double lhs = q_lo * q_lo * ((1 - r) * (1 - r));
+  const double rhs = (s_hi * s_hi + t_hi * t_hi) * ((1 + r) * (1 + r));
+  return lhs * (1 - kGamma) > rhs * (1 + kGamma);
+}
+
 template <int D>
 double control_ratio_lower(const double* const* entries, const double* err, int size) {
   constexpr int kEntries = D * (D + 1) / 2;
@@ -205,9 +221,12 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
   double m[kEntries];
   for (int k = 0; k < size && r > 0; ++k) {
     for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
+    // Most control matrices lie well above the least ratio found so far: certify that
+    // cheaply and skip their eigenvalue enclosure (r stays a lower bound of their ratios).
+    if constexpr (D == 2) {
+      if (r < 1 && ratio_at_least2(m, e, r)) continue;
+    }
     if constexpr (D == 3) {
-      // Most control matrices lie well above the least ratio found so far: certify that
-      // cheaply and skip their eigenvalue enclosure (the minimum, hence r, is unchanged).
       if (r < 1 && ratio_at_least3(m, e, r)) continue;
       double lo, hi;
       if (extreme_eigen_bounds3(m, e, lo, hi)) {

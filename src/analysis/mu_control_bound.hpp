@@ -61,6 +61,12 @@ EigenEnclosure symmetric_eigen_enclosure(const double* m, double err);
 ///         to rounding): use symmetric_eigen_enclosure then.
 bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi);
 
+/// True when lambda_min >= r lambda_max is certified for every exact symmetric 2 x 2
+/// matrix M with |M_ij - m_ij| <= err (entries m00, m11, m01), without square roots: the
+/// test control_ratio_lower makes before enclosing a matrix's eigenvalues.
+/// @pre 0 <= r < 1
+bool ratio_at_least2(const double* m, double err, double r);
+
 /// Certified lower bound of min R over a subdomain (the concavity argument above): the
 /// least certified ratio over the control matrices. A matrix whose ratio is certified to
 /// be at least the least one so far without eigenvalues (Laguerre-Samuelson bound of

@@ -151,6 +151,41 @@ void check_enclosure_of_random_matrices(unsigned seed) {
 TEST(MuControlBound, EigenEnclosure2x2MatchesExactArithmetic) { check_enclosure_of_random_matrices<2>(5); }
 TEST(MuControlBound, EigenEnclosure3x3MatchesExactArithmetic) { check_enclosure_of_random_matrices<3>(6); }
 
+// ratio_at_least2 against exact rational arithmetic: whenever it certifies
+// lambda_min >= r lambda_max, that holds at the corners of the error box and at random
+// points in it (lambda = q -+ d, so with q > 0 the claim is q (1 - r) >= d (1 + r), squared
+// below); r is drawn at random and within 1e-12 .. 1e-3 of the matrix's own ratio.
+TEST(MuControlBound, RatioAtLeast2HoldsInExactArithmetic) {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int certified = 0, near_and_certified = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double scale = std::ldexp(1.0, static_cast<int>(40 * u(rng)));
+    double m[3] = {scale * (1 + u(rng)), scale * (1 + u(rng)), scale * u(rng)};
+    const double err = trial % 3 == 0 ? 0.0 : scale * 1e-7 * (1 + u(rng));
+    const double q = 0.5 * (m[0] + m[1]), d = std::hypot(0.5 * (m[0] - m[1]), m[2]);
+    const double ratio = q > d ? (q - d) / (q + d) : 0.0;
+    const double gap = std::ldexp(1.0, -static_cast<int>(10 + 30 * (u(rng) + 1) / 2));  // 2^-10 .. 2^-40
+    const double r = trial % 2 == 0 ? std::abs(u(rng)) * 0.999 : std::clamp(ratio * (1 + gap * u(rng)), 0.0, 0.999);
+    if (!ratio_at_least2(m, err, r)) continue;
+    ++certified;
+    if (std::abs(r - ratio) < 1e-3 * ratio) ++near_and_certified;
+    for (int s = 0; s < 6; ++s) {
+      mpq_class p[3];
+      for (int i = 0; i < 3; ++i) {
+        const double sign = s < 4 ? ((s >> (i % 2)) & 1 ? 1.0 : -1.0) : u(rng);
+        p[i] = mpq_class(m[i]) + mpq_class(err) * mpq_class(sign);
+      }
+      const mpq_class qe = (p[0] + p[1]) / 2, se = (p[0] - p[1]) / 2, rr(r);
+      ASSERT_GT(qe, 0) << "trial " << trial;
+      ASSERT_GE(qe * qe * (1 - rr) * (1 - rr), (se * se + p[2] * p[2]) * (1 + rr) * (1 + rr))
+          << "lambda_min < r lambda_max, trial " << trial;
+    }
+  }
+  EXPECT_GT(certified, 3000);
+  EXPECT_GT(near_and_certified, 1000);  // tight: it certifies r close to the ratio itself
+}
+
 TEST(MuControlBound, RatioBoundsOfScaledIdentityAndStretch) {
   // Closed forms: diag(4, 1, 1) has ratio 1/4; c I has 1.
   const double m1[6] = {4, 1, 1, 0, 0, 0};
