@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <span>
@@ -237,6 +238,10 @@ const BezierBasis& bezier_basis(ElementFamily family, int order);
 
 /// gamma_k = k u / (1 - k u), u = 2^-53: the classical bound on the relative rounding
 /// error of a k-term floating-point sum of products (Higham, Accuracy and Stability, §3.1).
-double rounding_gamma(int k) noexcept;
+/// Inline, so that a constant k folds to a constant (it is taken per control point).
+constexpr double rounding_gamma(int k) noexcept {
+  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
+  return k * u / (1 - k * u);
+}
 
 }  // namespace quadval

@@ -15,11 +15,6 @@
 
 namespace quadval {
 
-double rounding_gamma(int k) noexcept {
-  constexpr double u = std::numeric_limits<double>::epsilon() / 2;
-  return k * u / (1 - k * u);
-}
-
 std::vector<FactorDegree> jacobian_factor_degrees(ElementFamily family, int p) {
   switch (family) {
     case ElementFamily::line: return {{1, p - 1}};
