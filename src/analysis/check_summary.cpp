@@ -122,11 +122,11 @@ void add_elements(CheckSummary& s, const CheckBatch& b, std::size_t from, std::s
     s.histogram.add(q);
     if (s.worst.may_take(q)) s.worst.offer(worst_entry(b.first + i, e, q));
   }
-  // mu and sj are computed for analysed elements only (NaN otherwise).
-  for (auto [values, summary] : {std::pair{b.mu, &s.mu}, std::pair{b.sj, &s.sj}}) {
-    if (values.empty() || !(summary == &s.mu ? measures_mu(s.measure) : measures_scaled_jacobian(s.measure)))
-      continue;
-    for (std::size_t i = from; i < to; ++i) {
+  // mu and the scaled Jacobian where measured (NaN lower bounds: not computed).
+  for (auto [on, values, summary] : {std::tuple{measures_mu(s.measure), b.mu, &s.mu},
+                                     std::tuple{measures_scaled_jacobian(s.measure), b.sj, &s.sj}}) {
+    if (!on) continue;
+    for (std::size_t i = from; i < to && !values.empty(); ++i) {
       const QualityBounds& bounds = values[i];
       if (std::isnan(bounds.lower)) continue;
       summary->histogram.add(bounds.lower);

@@ -783,9 +783,7 @@ void JacobianProduct::coefficients(SampleMap which, const double* nodes, std::si
   std::size_t e = 0;
   for (; e + lanes <= count; e += lanes)
     lane_block<kLanes>(map, nodes + e * stride, stride, planar, coeffs + e * S, errors + e, sc.block.data());
-  // The rest one by one, each in two lanes (stride 0): GCC keeps a one-double vector in
-  // memory, with a store and a reload around every operation, a two-double one in a
-  // register. Lanes compute alike, so lane 0 is the element's result.
+  // The rest one by one, each in two lanes (stride 0; lane_vector.hpp on one-lane vectors).
   sc.pair.resize(2 * S);
   for (; e < count; ++e) {
     double err[2];

@@ -177,9 +177,7 @@ void StraightSidedMargin::lane_margins(const double* nodes, std::size_t stride, 
   }
 }
 
-// One element runs in two lanes (stride 0), as GCC keeps a one-double vector in memory, with
-// a store and a reload around every operation, and a two-double one in a register: 3x less
-// time per element (scaled Jacobian of straight tetrahedra). Lanes compute alike.
+// One element in two lanes (stride 0): see lane_vector.hpp on one-lane vectors.
 double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& beta) const noexcept {
   if (kind_ == LinearKind::none) return kInf;
   double m[2] = {kInf, kInf}, b[6] = {};
@@ -196,7 +194,7 @@ void StraightSidedMargin::margins(const double* nodes, std::size_t count, double
   const std::size_t stride = static_cast<std::size_t>(num_nodes_) * 3;
   std::size_t e = 0;
   for (; e + kLanes <= count; e += kLanes) lane_margins<kLanes>(nodes + e * stride, stride, out + e);
-  for (; e < count; ++e) {  // two lanes of one element, as in margin()
+  for (; e < count; ++e) {  // one element in two lanes, as in margin()
     double m[2];
     lane_margins<2>(nodes + e * stride, 0, m);
     out[e] = m[0];
