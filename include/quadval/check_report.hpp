@@ -160,7 +160,7 @@ class WorstList {
   /// False only when an element of this key cannot enter the list (it is full and its
   /// highest key is lower): a test before building the element, on every element.
   bool may_take(double key) const noexcept {
-    return heap_.size() < capacity_ || !(key > heap_.front().key);
+    return heap_.size() < capacity_ || (!heap_.empty() && !(key > heap_.front().key));
   }
   /// The kept elements, lowest first.
   std::vector<WorstElement> sorted() const;

@@ -302,12 +302,20 @@ TEST(CheckStream, WorstListKeepsTheLowestWhateverTheOrder) {
   want.resize(15);
   for (int trial = 0; trial < 5; ++trial) {
     std::shuffle(all.begin(), all.end(), rng);
-    WorstList list(15);
-    for (const WorstElement& e : all) list.offer(e);
-    const auto got = list.sorted();
-    ASSERT_EQ(got.size(), want.size());
-    for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k].index, want[k].index) << k;
+    WorstList list(15), gated(15);  // gated: offered only what may_take lets through
+    for (const WorstElement& e : all) {
+      list.offer(e);
+      if (gated.may_take(e.key)) gated.offer(e);
+    }
+    for (const WorstList* l : {&list, &gated}) {
+      const auto got = l->sorted();
+      ASSERT_EQ(got.size(), want.size());
+      for (std::size_t k = 0; k < got.size(); ++k) EXPECT_EQ(got[k].index, want[k].index) << k;
+    }
   }
+  const WorstList none(0);
+  EXPECT_FALSE(none.may_take(0.5));
+  EXPECT_FALSE(none.may_take(std::nan("")));
 }
 
 std::string slurp(const std::filesystem::path& p) {
