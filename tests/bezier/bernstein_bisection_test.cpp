@@ -296,7 +296,12 @@ INSTANTIATE_TEST_SUITE_P(Spaces, BisectionTest,
                          testing::Values(std::vector<FactorDegree>{{1, 7}}, std::vector<FactorDegree>{{2, 6}},
                                          std::vector<FactorDegree>{{3, 5}}, std::vector<FactorDegree>{{1, 3}, {1, 4}},
                                          std::vector<FactorDegree>{{2, 3}, {1, 2}},
-                                         std::vector<FactorDegree>{{1, 2}, {1, 3}, {1, 1}}));
+                                         std::vector<FactorDegree>{{1, 2}, {1, 3}, {1, 1}},
+                                         // Runs of 8 lines in lanes and shorter ones (bisect's
+                                         // paths): the spaces of N and D of quadratic hexahedra
+                                         // and prisms.
+                                         std::vector<FactorDegree>{{1, 10}, {1, 10}, {1, 10}},
+                                         std::vector<FactorDegree>{{2, 6}, {1, 9}}));
 
 TEST(Bisection, DiametersHalveEveryDimLevels) {
   // Maubach's refinement of the reference tetrahedron (diameter sqrt 2): d = 3 bisections
