@@ -60,7 +60,7 @@ struct Leaf {
 };
 
 struct Scratch {
-  std::vector<double> values, parent, parent_err, children, child_err;
+  std::vector<double> values, child_err;
   std::vector<double> pool, pool_err;
   std::vector<BisectionState> states, child_states;  // states[slot]: the leaf's bisection state
   std::vector<int> free_slots;
@@ -655,7 +655,6 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   const auto levels = static_cast<long>(b2.levels());
   long halvings = 0;
   constexpr std::size_t nc = 2;
-  ws.children.resize(nc * stride);
   ws.child_states.resize(nc);
   ws.child_err.resize(nvec);
   auto& child_err = ws.child_err;
@@ -676,21 +675,10 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     std::pop_heap(ws.heap.begin(), ws.heap.end(), cmp);
     ws.heap.pop_back();
     ++halvings;
-    ws.free_slots.push_back(top.slot);
-    ws.parent_err.assign(ws.pool_err.begin() + top.slot * static_cast<std::ptrdiff_t>(nvec),
-                         ws.pool_err.begin() + (top.slot + 1) * static_cast<std::ptrdiff_t>(nvec));
-    const auto& parent_err = ws.parent_err;
-    // The parent is copied out first: its slot is reused by its children.
-    ws.parent.assign(ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off),
-                     ws.pool.begin() + static_cast<std::ptrdiff_t>(parent_off + stride));
-    const BisectionState parent_state = ws.states[static_cast<std::size_t>(top.slot)];
-    for (std::size_t v = 0; v < nvec; ++v)
-      child_err[v] = up((parent_err[v] + b2.halving_rounding_relative() * max_abs(ws.parent.data() + v * s2, s2) +
-                         b2.halving_rounding_absolute()) * (1 + 1e-12));
-    // All nvec vectors of both children at once (bit-identical to one at a time).
-    b2.halve(ws.parent.data(), nvec, parent_state, ws.children.data(), ws.child_states.data());
-    for (std::size_t q = 0; q < nc; ++q) {
-      int slot;
+    // The children get slots of their own, so that they are written straight from the
+    // parent's; the parent's slot is freed after.
+    int child_slot[nc];
+    for (int& slot : child_slot) {
       if (!ws.free_slots.empty()) {
         slot = ws.free_slots.back();
         ws.free_slots.pop_back();
@@ -700,9 +688,19 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
         ws.pool_err.resize(ws.pool_err.size() + nvec);
         ws.states.resize(ws.states.size() + 1);
       }
-      std::copy(ws.children.begin() + static_cast<std::ptrdiff_t>(q * stride),
-                ws.children.begin() + static_cast<std::ptrdiff_t>((q + 1) * stride),
-                ws.pool.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(slot) * stride));
+    }
+    const double* parent = ws.pool.data() + parent_off;
+    const double* parent_err = ws.pool_err.data() + top.slot * static_cast<std::ptrdiff_t>(nvec);
+    for (std::size_t v = 0; v < nvec; ++v)
+      child_err[v] = up((parent_err[v] + b2.halving_rounding_relative() * max_abs(parent + v * s2, s2) +
+                         b2.halving_rounding_absolute()) * (1 + 1e-12));
+    // All nvec vectors of both children at once (bit-identical to one at a time).
+    b2.halve(parent, nvec, ws.states[static_cast<std::size_t>(top.slot)],
+             ws.pool.data() + static_cast<std::size_t>(child_slot[0]) * stride,
+             ws.pool.data() + static_cast<std::size_t>(child_slot[1]) * stride, ws.child_states.data());
+    ws.free_slots.push_back(top.slot);
+    for (std::size_t q = 0; q < nc; ++q) {
+      const int slot = child_slot[q];
       std::copy(child_err.begin(), child_err.end(), ws.pool_err.begin() + slot * static_cast<std::ptrdiff_t>(nvec));
       ws.states[static_cast<std::size_t>(slot)] = ws.child_states[q];
       push(slot);

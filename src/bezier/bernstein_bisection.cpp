@@ -269,6 +269,11 @@ void BernsteinBisection::split(const double* parent, std::size_t count, const Bi
 
 void BernsteinBisection::halve(const double* parent, std::size_t count, const BisectionState& state,
                                double* children, BisectionState* states) const {
+  halve(parent, count, state, children, children + static_cast<std::size_t>(size_) * count, states);
+}
+
+void BernsteinBisection::halve(const double* parent, std::size_t count, const BisectionState& state,
+                               double* first_child, double* second_child, BisectionState* states) const {
   // The factor split() would bisect at this point of its sequence.
   int level = state.step % dim_;
   std::size_t f = 0;
@@ -276,8 +281,7 @@ void BernsteinBisection::halve(const double* parent, std::size_t count, const Bi
   const auto& o = state.order[f];
   const int k = state.tag[f];
   const int a = o[0], b = o[static_cast<std::size_t>(k)];
-  const std::size_t block = static_cast<std::size_t>(size_) * count;
-  bisect(parent, count, f, a, b, children, children + block);
+  bisect(parent, count, f, a, b, first_child, second_child);
   const auto tag = static_cast<std::int8_t>(k > 1 ? k - 1 : factors_[f].dim);
   BisectionState first = state, second = state;
   first.tag[f] = tag;

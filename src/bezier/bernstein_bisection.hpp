@@ -95,6 +95,10 @@ class BernsteinBisection {
   /// @param states   out: 2 states (step = state.step + 1)
   void halve(const double* parent, std::size_t count, const BisectionState& state, double* children,
              BisectionState* states) const;
+  /// The same, each child's count x size() block at its own place (first: states[0]).
+  /// @pre neither block overlaps parent
+  void halve(const double* parent, std::size_t count, const BisectionState& state, double* first,
+             double* second, BisectionState* states) const;
   /// The rounding bounds of halve(), as below for split().
   double halving_rounding_relative() const noexcept { return halving_relative_; }
   double halving_rounding_absolute() const noexcept { return halving_absolute_; }
