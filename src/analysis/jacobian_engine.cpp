@@ -14,6 +14,7 @@
 #include <queue>
 
 #include "bezier/bezier_exact.hpp"
+#include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
@@ -99,11 +100,8 @@ MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, dou
 
   const auto bounds_of = [&](const double* b, double e, double& lower, double& upper,
                              double& max_abs) {
-    double lo = b[0], hi = kInf, big = 0;
-    for (std::size_t i = 0; i < size; ++i) {
-      lo = std::min(lo, b[i]);
-      big = std::max(big, std::abs(b[i]));
-    }
+    const double lo = least_value(b, size), big = largest_magnitude(b, size);
+    double hi = kInf;
     for (int v : vertices) hi = std::min(hi, b[v]);
     lower = down(lo - e);
     upper = up(hi + e);
@@ -156,11 +154,7 @@ MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, dou
     r.subdivisions = static_cast<int>((halvings + levels - 1) / levels);
 
     const double* parent = ws.pool.data() + static_cast<std::size_t>(leaf.slot) * size;
-    double parent_min = parent[0], parent_max_abs = 0;
-    for (std::size_t i = 0; i < size; ++i) {
-      parent_min = std::min(parent_min, parent[i]);
-      parent_max_abs = std::max(parent_max_abs, std::abs(parent[i]));
-    }
+    const double parent_min = least_value(parent, size), parent_max_abs = largest_magnitude(parent, size);
     if (std::abs(parent_min) <= 8 * leaf.err) r.rounding_limited = true;
     // Averages never exceed their inputs: the parent's error plus the halving's rounding.
     const double child_err =

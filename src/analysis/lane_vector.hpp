@@ -6,6 +6,9 @@
 // Avoid W = 1: GCC 12 keeps a one-double vector in memory, with a store and a reload around
 // every operation (measured: twice the time of two lanes). One element runs in two lanes
 // instead, both reading it, and lane 0 is its result.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <cstring>
 
 namespace quadval {
@@ -22,6 +25,76 @@ Lanes<W> load_lanes(const double* p) {
   Lanes<W> v;
   std::memcpy(&v, p, sizeof v);
   return v;
+}
+
+}  // namespace quadval
+
+namespace quadval {
+
+// Folds by min and max, lane by lane. Loops written with these instead of
+// `#pragma omp simd reduction(min : m)` over std::min: GCC 12 compiles that reduction into
+// masked gathers from an accumulator kept on the stack, one round trip through memory per
+// step (a quarter of the scaled Jacobian's time on warped_tetrahedron_o3).
+
+/// Every lane v.
+template <int W>
+Lanes<W> broadcast_lanes(double v) {
+  return Lanes<W>{} + v;
+}
+/// std::min(m, x) on every lane: x where x < m, else m (V: a Lanes<W>).
+template <class V>
+V min_lanes(V m, V x) {
+  return x < m ? x : m;
+}
+/// std::max(m, x) on every lane: x where m < x, else m.
+template <class V>
+V max_lanes(V m, V x) {
+  return m < x ? x : m;
+}
+/// m folded with the lanes of v by std::min, lane 0 first.
+template <class V>
+double fold_min(V v, double m) {
+  for (std::size_t l = 0; l < sizeof(V) / sizeof(double); ++l) m = std::min(m, v[l]);
+  return m;
+}
+/// m folded with the lanes of v by std::max, lane 0 first.
+template <class V>
+double fold_max(V v, double m) {
+  for (std::size_t l = 0; l < sizeof(V) / sizeof(double); ++l) m = std::max(m, v[l]);
+  return m;
+}
+
+// Below this many values a plain loop is faster than the lanes and their final fold (mu of
+// quadratic quadrangles: 3% slower with lanes from 8 values on).
+inline constexpr std::size_t kFoldLanesFrom = 32;
+
+/// The least of x_0..x_{n-1} as std::min folds them (+inf for n = 0), 8 lanes at a time.
+inline double least_value(const double* x, std::size_t n) {
+  constexpr double kInf = __builtin_inf();
+  double m = kInf;
+  std::size_t i = 0;
+  if (n >= kFoldLanesFrom) {
+    Lanes<8> m8 = broadcast_lanes<8>(kInf);
+    for (; i + 8 <= n; i += 8) m8 = min_lanes(m8, load_lanes<8>(x + i));
+    m = fold_min(m8, kInf);
+  }
+  for (; i < n; ++i) m = std::min(m, x[i]);
+  return m;
+}
+/// max(0, |x_0|, ..., |x_{n-1}|) as std::max folds it, 8 lanes at a time.
+inline double largest_magnitude(const double* x, std::size_t n) {
+  double m = 0;
+  std::size_t i = 0;
+  if (n >= kFoldLanesFrom) {
+    Lanes<8> m8 = broadcast_lanes<8>(0);
+    for (; i + 8 <= n; i += 8) {
+      const Lanes<8> v = load_lanes<8>(x + i);
+      m8 = max_lanes(m8, v < 0 ? -v : v);
+    }
+    m = fold_max(m8, 0.0);
+  }
+  for (; i < n; ++i) m = std::max(m, std::abs(x[i]));
+  return m;
 }
 
 }  // namespace quadval

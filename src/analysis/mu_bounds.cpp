@@ -12,6 +12,7 @@
 #include <queue>
 #include <vector>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/mu_constant.hpp"
 #include "analysis/mu_control_bound.hpp"
 #include "analysis/mu_metric.hpp"
@@ -220,8 +221,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   bool constant = false;
   if (mu_constant_path_enabled()) {
     delta = constant_w_radius(space, pool.data(), err0);
-    double wmax = 0;
-    for (std::size_t i = 0; i < block; ++i) wmax = std::max(wmax, std::abs(pool[i]));
+    const double wmax = largest_magnitude(pool.data(), block);
     constant = delta <= 1e-9 * wmax;
   }
   const int corner = basis.vertex_indices()[0];
@@ -304,8 +304,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
     ++steps;
     out.subdivisions = static_cast<int>((steps + levels - 1) / levels);
     const auto par = static_cast<std::size_t>(top.slot) * block;
-    double wmax = 0;
-    for (std::size_t i = 0; i < block; ++i) wmax = std::max(wmax, std::abs(pool[par + i]));
+    const double wmax = largest_magnitude(pool.data() + par, block);
     // Averages (halving) and rows of exact nonnegative weights summing to 1 (midpoint
     // children) never exceed their inputs: the parent's error plus the step's rounding.
     const double child_err =

@@ -17,6 +17,7 @@
 #include <limits>
 #include <tuple>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/mu_control_bound.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "quadval/error.hpp"
@@ -27,11 +28,7 @@ namespace {
 constexpr double kSlack = 1 + 1e-12;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double max_abs(const std::vector<double>& v) {
-  double m = 0;
-  for (double x : v) m = std::max(m, std::abs(x));
-  return m;
-}
+double max_abs(const std::vector<double>& v) { return largest_magnitude(v.data(), v.size()); }
 
 // Largest rho (rounded down) with rho * D <= N certified coefficient-wise (Paper V §3.1,
 // both signs of the denominator); -inf when no rho satisfies every coefficient, +inf when

@@ -6,6 +6,7 @@
 #include <queue>
 #include <vector>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 
 namespace quadval {
@@ -85,11 +86,7 @@ RatioRefinement refine_ratio_minimum(const BezierBasis& basis, const double* b, 
     std::copy(pool.begin() + static_cast<std::ptrdiff_t>(off),
               pool.begin() + static_cast<std::ptrdiff_t>(off + 2 * s), parent.begin());
     free_slots.push_back(top.slot);
-    double max_b = 0, max_c = 0;
-    for (std::size_t i = 0; i < s; ++i) {
-      max_b = std::max(max_b, std::abs(parent[i]));
-      max_c = std::max(max_c, std::abs(parent[s + i]));
-    }
+    const double max_b = largest_magnitude(parent.data(), s), max_c = largest_magnitude(parent.data() + s, s);
     const double eb = next_up((top.err_b + basis.subdivision_rounding() * max_b) * (1 + 1e-12));
     const double ec = next_up((top.err_c + basis.subdivision_rounding() * max_c) * (1 + 1e-12));
     for (int q = 0; q < basis.num_children(); ++q) {

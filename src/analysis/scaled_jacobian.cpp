@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "analysis/jacobian_samples.hpp"
+#include "analysis/lane_vector.hpp"
 #include "analysis/linear_jacobian.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_quotient.hpp"
@@ -31,6 +32,7 @@ namespace {
 
 constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kW = 8;  // lanes of the vectorised folds
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
 // Splits of J and the columns before the products (the quotient stage, which refines only
@@ -47,11 +49,7 @@ struct Eb {
   double m = 0, e = 0;
 };
 
-double max_abs(const double* x, std::size_t n) {
-  double m = 0;
-  for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::abs(x[i]));
-  return m;
-}
+double max_abs(const double* x, std::size_t n) { return largest_magnitude(x, n); }
 
 struct Leaf {
   double lower;
@@ -93,9 +91,15 @@ class Bounder {
       for (std::size_t k = 0; k < frames_; ++k) {
         const double* d = v + (2 + k) * size_;
         const double ed = err[2 + k];
-        double least_d = kInf, rk = kInf;
-#pragma omp simd reduction(min : least_d, rk)
-        for (std::size_t i = 0; i < size_; ++i) {
+        Lanes<kW> least_d8 = broadcast_lanes<kW>(kInf), rk8 = least_d8;
+        std::size_t i = 0;
+        for (; i + kW <= size_; i += kW) {
+          const Lanes<kW> di = load_lanes<kW>(d + i);
+          least_d8 = min_lanes(least_d8, di - ed);
+          rk8 = min_lanes(rk8, (load_lanes<kW>(n + i) - err[1]) / (di + ed));
+        }
+        double least_d = fold_min(least_d8, kInf), rk = fold_min(rk8, kInf);
+        for (; i < size_; ++i) {
           least_d = std::min(least_d, d[i] - ed);
           rk = std::min(rk, (n[i] - err[1]) / (d[i] + ed));
         }
@@ -189,13 +193,8 @@ class Bounder {
   }
 
  private:
-  // The least of the size_ values at x (vectorised).
-  double least(const double* x) const {
-    double m = kInf;
-#pragma omp simd reduction(min : m)
-    for (std::size_t i = 0; i < size_; ++i) m = std::min(m, x[i]);
-    return m;
-  }
+  // The least of the size_ values at x (vectorised: lane_vector.hpp says why by hand).
+  double least(const double* x) const { return least_value(x, size_); }
 
   // An upper bound of max_i (num_i + num_err) / (den_i - den_err), at least 0, or 1 (no
   // bound) unless every den_i - den_err is positive. One pass without directed roundings
@@ -204,9 +203,15 @@ class Bounder {
   // loses at most denorm_min), so (1 + 4u) times the computed maximum, rounded up, plus
   // denorm_min covers the exact one.
   double max_ratio(const double* num, double num_err, const double* den, double den_err) const {
-    double least = kInf, r = 0;
-#pragma omp simd reduction(min : least) reduction(max : r)
-    for (std::size_t i = 0; i < size_; ++i) {
+    Lanes<kW> least8 = broadcast_lanes<kW>(kInf), r8 = broadcast_lanes<kW>(0);
+    std::size_t i = 0;
+    for (; i + kW <= size_; i += kW) {
+      const Lanes<kW> d = load_lanes<kW>(den + i) - den_err;
+      least8 = min_lanes(least8, d);
+      r8 = max_lanes(r8, (load_lanes<kW>(num + i) + num_err) / d);
+    }
+    double least = fold_min(least8, kInf), r = fold_max(r8, 0.0);
+    for (; i < size_; ++i) {
       const double d = den[i] - den_err;
       least = std::min(least, d);
       r = std::max(r, (num[i] + num_err) / d);

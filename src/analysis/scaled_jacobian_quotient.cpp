@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "analysis/jacobian_samples.hpp"
+#include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/error.hpp"
@@ -263,9 +264,7 @@ class Quotient {
     children.resize(nc * layout_.stride);
     states.resize(nc);
     const auto child_error = [](const BernsteinBisection& b, double e, const double* v, std::size_t n) {
-      double m = 0;
-      for (std::size_t i = 0; i < n; ++i) m = std::max(m, std::abs(v[i]));
-      return up((e + b.rounding_relative() * m + b.rounding_absolute()) * (1 + 1e-12));
+      return up((e + b.rounding_relative() * largest_magnitude(v, n) + b.rounding_absolute()) * (1 + 1e-12));
     };
     const std::size_t sj = in_.j.size();
     part_.resize(nc * layout_.stride);  // any one part's children: layout_.stride >= J's and 3 x a column's size

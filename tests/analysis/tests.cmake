@@ -19,6 +19,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/linear_fast_path_test.cpp
   analysis/straight_sided_test.cpp
   analysis/outward_rounding_test.cpp
+  analysis/lane_folds_test.cpp
   analysis/jacobian_batch_test.cpp
   analysis/check_threads_test.cpp
   analysis/worker_threads_test.cpp
