@@ -27,10 +27,6 @@ Lanes<W> load_lanes(const double* p) {
   return v;
 }
 
-}  // namespace quadval
-
-namespace quadval {
-
 // Folds by min and max, lane by lane. Loops written with these instead of
 // `#pragma omp simd reduction(min : m)` over std::min: GCC 12 compiles that reduction into
 // masked gathers from an accumulator kept on the stack, one round trip through memory per
