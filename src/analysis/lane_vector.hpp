@@ -37,15 +37,20 @@ template <int W>
 Lanes<W> broadcast_lanes(double v) {
   return Lanes<W>{} + v;
 }
-/// std::min(m, x) on every lane: x where x < m, else m (V: a Lanes<W>).
+/// std::min(a, b) on every lane (b where b < a, else a); V: Lanes<W> or double.
 template <class V>
-V min_lanes(V m, V x) {
-  return x < m ? x : m;
+V vmin(V a, V b) {
+  return b < a ? b : a;
 }
-/// std::max(m, x) on every lane: x where m < x, else m.
+/// std::max(a, b) on every lane (b where a < b, else a).
 template <class V>
-V max_lanes(V m, V x) {
-  return m < x ? x : m;
+V vmax(V a, V b) {
+  return a < b ? b : a;
+}
+/// |a| on every lane (-0 stays -0, which no comparison tells from +0).
+template <class V>
+V vabs(V a) {
+  return a < 0 ? -a : a;
 }
 /// m folded with the lanes of v by std::min, lane 0 first.
 template <class V>
@@ -71,7 +76,7 @@ inline double least_value(const double* x, std::size_t n) {
   std::size_t i = 0;
   if (n >= kFoldLanesFrom) {
     Lanes<8> m8 = broadcast_lanes<8>(kInf);
-    for (; i + 8 <= n; i += 8) m8 = min_lanes(m8, load_lanes<8>(x + i));
+    for (; i + 8 <= n; i += 8) m8 = vmin(m8, load_lanes<8>(x + i));
     m = fold_min(m8, kInf);
   }
   for (; i < n; ++i) m = std::min(m, x[i]);
@@ -83,10 +88,7 @@ inline double largest_magnitude(const double* x, std::size_t n) {
   std::size_t i = 0;
   if (n >= kFoldLanesFrom) {
     Lanes<8> m8 = broadcast_lanes<8>(0);
-    for (; i + 8 <= n; i += 8) {
-      const Lanes<8> v = load_lanes<8>(x + i);
-      m8 = max_lanes(m8, v < 0 ? -v : v);
-    }
+    for (; i + 8 <= n; i += 8) m8 = vmax(m8, vabs(load_lanes<8>(x + i)));
     m = fold_max(m8, 0.0);
   }
   for (; i < n; ++i) m = std::max(m, std::abs(x[i]));

@@ -49,8 +49,6 @@ struct Eb {
   double m = 0, e = 0;
 };
 
-double max_abs(const double* x, std::size_t n) { return largest_magnitude(x, n); }
-
 struct Leaf {
   double lower;
   int slot;
@@ -95,8 +93,8 @@ class Bounder {
         std::size_t i = 0;
         for (; i + kW <= size_; i += kW) {
           const Lanes<kW> di = load_lanes<kW>(d + i);
-          least_d8 = min_lanes(least_d8, di - ed);
-          rk8 = min_lanes(rk8, (load_lanes<kW>(n + i) - err[1]) / (di + ed));
+          least_d8 = vmin(least_d8, di - ed);
+          rk8 = vmin(rk8, (load_lanes<kW>(n + i) - err[1]) / (di + ed));
         }
         double least_d = fold_min(least_d8, kInf), rk = fold_min(rk8, kInf);
         for (; i < size_; ++i) {
@@ -207,8 +205,8 @@ class Bounder {
     std::size_t i = 0;
     for (; i + kW <= size_; i += kW) {
       const Lanes<kW> d = load_lanes<kW>(den + i) - den_err;
-      least8 = min_lanes(least8, d);
-      r8 = max_lanes(r8, (load_lanes<kW>(num + i) + num_err) / d);
+      least8 = vmin(least8, d);
+      r8 = vmax(r8, (load_lanes<kW>(num + i) + num_err) / d);
     }
     double least = fold_min(least8, kInf), r = fold_max(r8, 0.0);
     for (; i < size_; ++i) {
@@ -235,7 +233,7 @@ struct Poly {
   Eb b;
 };
 
-void refresh_magnitude(Poly& p) { p.b.m = max_abs(p.c.data(), p.c.size()); }
+void refresh_magnitude(Poly& p) { p.b.m = largest_magnitude(p.c.data(), p.c.size()); }
 
 struct ProductTerm {
   const Poly* f;
@@ -697,7 +695,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     const double* parent = ws.pool.data() + parent_off;
     const double* parent_err = ws.pool_err.data() + top.slot * static_cast<std::ptrdiff_t>(nvec);
     for (std::size_t v = 0; v < nvec; ++v)
-      child_err[v] = up((parent_err[v] + b2.halving_rounding_relative() * max_abs(parent + v * s2, s2) +
+      child_err[v] = up((parent_err[v] + b2.halving_rounding_relative() * largest_magnitude(parent + v * s2, s2) +
                          b2.halving_rounding_absolute()) * (1 + 1e-12));
     // All nvec vectors of both children at once (bit-identical to one at a time).
     b2.halve(parent, nvec, ws.states[static_cast<std::size_t>(top.slot)],

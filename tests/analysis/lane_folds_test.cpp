@@ -1,5 +1,5 @@
-// The vectorised folds of lane_vector.hpp (least_value, largest_magnitude, min_lanes,
-// max_lanes) against std::min_element and a plain loop of std::max(|x|): every length from
+// The vectorised folds of lane_vector.hpp (least_value, largest_magnitude, vmin,
+// vmax) against std::min_element and a plain loop of std::max(|x|): every length from
 // 0 to 100 (the plain loop below kFoldLanesFrom, lanes and a tail above), values of both
 // signs, signed zeros, infinities and subnormals, bit for bit.
 #include <gtest/gtest.h>
@@ -48,8 +48,8 @@ TEST(LaneFolds, LaneMinAndMaxAreStdMinAndMaxPerLane) {
   std::mt19937_64 rng(12);
   for (int trial = 0; trial < 1000; ++trial) {
     const std::vector<double> a = sample(8, rng), b = sample(8, rng);
-    const Lanes<8> lo = min_lanes(load_lanes<8>(a.data()), load_lanes<8>(b.data()));
-    const Lanes<8> hi = max_lanes(load_lanes<8>(a.data()), load_lanes<8>(b.data()));
+    const Lanes<8> lo = vmin(load_lanes<8>(a.data()), load_lanes<8>(b.data()));
+    const Lanes<8> hi = vmax(load_lanes<8>(a.data()), load_lanes<8>(b.data()));
     for (int l = 0; l < 8; ++l) {
       const auto ul = static_cast<std::size_t>(l);
       EXPECT_EQ(std::bit_cast<std::uint64_t>(lo[l]), std::bit_cast<std::uint64_t>(std::min(a[ul], b[ul])));
