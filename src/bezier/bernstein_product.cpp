@@ -17,6 +17,7 @@
 // since the exact convex weights of one k sum to 1 — the same bound as the entry kernel.
 #include "bezier/bernstein_product.hpp"
 
+#include <algorithm>
 #include <array>
 #include <gmpxx.h>
 
@@ -213,6 +214,26 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
       pairs_.insert(pairs_.end(), r.begin(), r.end());
       row_start_.push_back(static_cast<int>(pairs_.size()));
     }
+    bool same_space = true;
+    for (std::size_t fac = 0; fac < f_degrees_.size(); ++fac)
+      same_space = same_space && f_degrees_[fac].degree == g_degrees_[fac].degree;
+    if (same_space) {
+      square_row_start_.push_back(0);
+      for (const auto& r : rows) {
+        std::size_t below = 0, diagonal = 0;
+        for (const Pair& q : r) {
+          if (q.i < q.j) {
+            square_pairs_.push_back({q.i, q.j, 2 * q.w});  // exact: a power of two
+            ++below;
+          } else if (q.i == q.j) {
+            square_pairs_.push_back(q);
+            ++diagonal;
+          }
+        }
+        QV_ASSERT(2 * below + diagonal == r.size(), "a product of one space is not symmetric");
+        square_row_start_.push_back(static_cast<int>(square_pairs_.size()));
+      }
+    }
   }
 }
 
@@ -275,8 +296,42 @@ void BernsteinProduct::fused_entries(std::span<const Term> terms, double* h) con
   }
 }
 
+// fused_entries over the rows of squares: per pair the same roundings (the doubled weight
+// is exact), fewer pairs per row, and the weights of a row still sum to 1: within
+// rounding(N) as well.
+template <std::size_t N>
+void BernsteinProduct::fused_squares(std::span<const Term> terms, double* h) const {
+  std::array<double, N> sc;
+  std::array<const double*, N> f;
+  for (std::size_t t = 0; t < N; ++t) {
+    sc[t] = terms[t].scale;
+    f[t] = terms[t].f;
+  }
+  const Pair* pairs = square_pairs_.data();
+  for (int k = 0; k < h_size_; ++k) {
+    double acc = 0;
+    for (int p = square_row_start_[static_cast<std::size_t>(k)]; p < square_row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
+      const int i = pairs[p].i, j = pairs[p].j;
+      if constexpr (N == 1) {
+        acc += pairs[p].w * (f[0][i] * f[0][j]);  // as multiply_add: scaled once per row
+      } else {
+        double sum = 0;
+        for (std::size_t t = 0; t < N; ++t) sum += sc[t] * (f[t][i] * f[t][j]);
+        acc += pairs[p].w * sum;
+      }
+    }
+    h[k] += N == 1 ? sc[0] * acc : acc;
+  }
+}
+
 void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) const {
   if (entries_kernel_) {
+    const bool squares = !square_pairs_.empty() &&
+                         std::all_of(terms.begin(), terms.end(), [](const Term& t) { return t.f == t.g; });
+    if (squares && terms.size() == 1) return fused_squares<1>(terms, h);
+    if (squares && terms.size() == 2) return fused_squares<2>(terms, h);
+    if (squares && terms.size() == 3) return fused_squares<3>(terms, h);
+    if (squares && terms.size() == 6) return fused_squares<6>(terms, h);
     if (!pairs_.empty() && terms.size() == 2) return fused_entries<2>(terms, h);
     if (!pairs_.empty() && terms.size() == 3) return fused_entries<3>(terms, h);
     for (const Term& t : terms) multiply_add(t.f, t.g, t.scale, h);

@@ -53,7 +53,8 @@ class BernsteinProduct {
     const double* g;
   };
   /// h += sum_t scale_t f_t g_t. The scaled convolution keeps the whole sum in scaled form
-  /// and unscales once, the entry kernel sums 2 or 3 terms per pair in one walk;
+  /// and unscales once, the entry kernel sums 2 or 3 terms per pair in one walk, and
+  /// squares (f_t == g_t, same pointer, in every term) in half the pairs;
   /// rounding(terms.size()) bounds the result as for repeated multiply_add.
   void multiply_add_sum(std::span<const Term> terms, double* h) const;
   /// Choose the per-factor weighted-entry loop (default for small products) or the scaled
@@ -83,8 +84,15 @@ class BernsteinProduct {
   };
   std::vector<int> row_start_;
   std::vector<Pair> pairs_;
+  // Squares (f and g in the same space): the pairs (i, j) and (j, i) of a row have the same
+  // weight, so f_i f_j appears twice; these rows keep i <= j, with the weight doubled
+  // (exactly) where i < j: about half the pairs, and a convex combination as before.
+  std::vector<int> square_row_start_;
+  std::vector<Pair> square_pairs_;
   template <std::size_t N>
   void fused_entries(std::span<const Term> terms, double* h) const;
+  template <std::size_t N>
+  void fused_squares(std::span<const Term> terms, double* h) const;
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
   // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k. Every

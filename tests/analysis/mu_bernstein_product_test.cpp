@@ -209,6 +209,42 @@ TEST(MuBernsteinProduct, SumsOfProductsMatchExactCoefficients) {
   }
 }
 
+TEST(MuBernsteinProduct, SumsOfSquaresMatchExactCoefficients) {
+  // Terms f_t * f_t (same pointer twice) take the entry kernel's rows of squares: each pair
+  // (i, j), i < j, once with twice its weight. Against exact rationals for 1, 2, 3 and 6
+  // terms (the counts with a fused walk) and 4 (separate products), on simplex and tensor
+  // spaces; a square row that dropped or failed to double its off-diagonal pairs would be
+  // off by about |f_i f_j| here, far beyond the rounding bound.
+  const std::vector<std::vector<FactorDegree>> spaces{
+      {{1, 3}}, {{2, 2}}, {{3, 3}}, {{1, 2}, {1, 2}, {1, 2}}, {{2, 2}, {1, 3}}, {{1, 1}, {1, 2}, {1, 0}}};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const auto& d : spaces)
+    for (const std::size_t count : {1u, 2u, 3u, 4u, 6u}) {
+      const BernsteinProduct& table = bernstein_product(d, d);
+      std::vector<std::vector<double>> fs(count);
+      std::vector<double> scales(count);
+      std::vector<BernsteinProduct::Term> terms;
+      double mag = 0;
+      for (std::size_t t = 0; t < count; ++t) {
+        double fm = 0;
+        fs[t].resize(static_cast<std::size_t>(table.f_size()));
+        for (double& v : fs[t]) fm = std::max(fm, std::abs(v = u(rng) * std::ldexp(1.0, static_cast<int>(6 * u(rng)))));
+        scales[t] = t % 2 == 0 ? 1.0 : -0.375;
+        mag += std::abs(scales[t]) * fm * fm;
+        terms.push_back({scales[t], fs[t].data(), fs[t].data()});
+      }
+      std::vector<double> h(static_cast<std::size_t>(table.h_size()), 0.0);
+      table.multiply_add_sum(terms, h.data());
+      const auto want = exact_product_sum(d, d, scales, fs, fs);
+      const double bound = table.rounding(static_cast<int>(count)) * mag;
+      EXPECT_LT(bound, 1e-12 * mag);
+      for (std::size_t k = 0; k < h.size(); ++k)
+        EXPECT_LE(mpq_class(abs(mpq_class(mpq_class(h[k]) - want[k]))).get_d(), bound)
+            << "space " << &d - spaces.data() << ", " << count << " terms, k " << k;
+    }
+}
+
 TEST(MuBernsteinProduct, ProductOfOnesIsOneAndWeightsAreConvex) {
   // 1 * 1 = 1: every product coefficient is a convex combination (weights sum to 1).
   const std::vector<FactorDegree> f{{2, 3}, {1, 2}}, g{{2, 4}, {1, 1}};
