@@ -274,8 +274,11 @@ void BernsteinProduct::accumulate_grid(const double* f, const double* g, double 
 // rounding(N): with the weight's own rounding, N + 3 per pair plus the row's max_terms
 // and the addition into h, at most N * max_terms + 16; and the weights of a row sum to 1,
 // so the magnitude is at most sum_t |scale_t| max|f_t| max|g_t|, as for N separate walks.
+// The rows of squares (f_t == g_t) hold the same sums in fewer pairs, each with the same
+// roundings (a doubled weight is exact): within rounding(N) as well.
 template <std::size_t N>
-void BernsteinProduct::fused_entries(std::span<const Term> terms, double* h) const {
+void BernsteinProduct::fused_entries(std::span<const Term> terms, const std::vector<int>& row_start,
+                                     const std::vector<Pair>& pair_list, double* h) const {
   std::array<double, N> sc;
   std::array<const double*, N> f, g;
   for (std::size_t t = 0; t < N; ++t) {
@@ -283,40 +286,16 @@ void BernsteinProduct::fused_entries(std::span<const Term> terms, double* h) con
     f[t] = terms[t].f;
     g[t] = terms[t].g;
   }
-  const Pair* pairs = pairs_.data();
+  const Pair* pairs = pair_list.data();
   for (int k = 0; k < h_size_; ++k) {
     double acc = 0;
-    for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
-      const int i = pairs[p].i, j = pairs[p].j;
-      double sum = 0;
-      for (std::size_t t = 0; t < N; ++t) sum += sc[t] * (f[t][i] * g[t][j]);
-      acc += pairs[p].w * sum;
-    }
-    h[k] += acc;
-  }
-}
-
-// fused_entries over the rows of squares: per pair the same roundings (the doubled weight
-// is exact), fewer pairs per row, and the weights of a row still sum to 1: within
-// rounding(N) as well.
-template <std::size_t N>
-void BernsteinProduct::fused_squares(std::span<const Term> terms, double* h) const {
-  std::array<double, N> sc;
-  std::array<const double*, N> f;
-  for (std::size_t t = 0; t < N; ++t) {
-    sc[t] = terms[t].scale;
-    f[t] = terms[t].f;
-  }
-  const Pair* pairs = square_pairs_.data();
-  for (int k = 0; k < h_size_; ++k) {
-    double acc = 0;
-    for (int p = square_row_start_[static_cast<std::size_t>(k)]; p < square_row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
+    for (int p = row_start[static_cast<std::size_t>(k)]; p < row_start[static_cast<std::size_t>(k) + 1]; ++p) {
       const int i = pairs[p].i, j = pairs[p].j;
       if constexpr (N == 1) {
-        acc += pairs[p].w * (f[0][i] * f[0][j]);  // as multiply_add: scaled once per row
+        acc += pairs[p].w * (f[0][i] * g[0][j]);  // as multiply_add: scaled once per row
       } else {
         double sum = 0;
-        for (std::size_t t = 0; t < N; ++t) sum += sc[t] * (f[t][i] * f[t][j]);
+        for (std::size_t t = 0; t < N; ++t) sum += sc[t] * (f[t][i] * g[t][j]);
         acc += pairs[p].w * sum;
       }
     }
@@ -328,12 +307,14 @@ void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) 
   if (entries_kernel_) {
     const bool squares = !square_pairs_.empty() &&
                          std::all_of(terms.begin(), terms.end(), [](const Term& t) { return t.f == t.g; });
-    if (squares && terms.size() == 1) return fused_squares<1>(terms, h);
-    if (squares && terms.size() == 2) return fused_squares<2>(terms, h);
-    if (squares && terms.size() == 3) return fused_squares<3>(terms, h);
-    if (squares && terms.size() == 6) return fused_squares<6>(terms, h);
-    if (!pairs_.empty() && terms.size() == 2) return fused_entries<2>(terms, h);
-    if (!pairs_.empty() && terms.size() == 3) return fused_entries<3>(terms, h);
+    if (squares) {
+      if (terms.size() == 1) return fused_entries<1>(terms, square_row_start_, square_pairs_, h);
+      if (terms.size() == 2) return fused_entries<2>(terms, square_row_start_, square_pairs_, h);
+      if (terms.size() == 3) return fused_entries<3>(terms, square_row_start_, square_pairs_, h);
+      if (terms.size() == 6) return fused_entries<6>(terms, square_row_start_, square_pairs_, h);
+    }
+    if (!pairs_.empty() && terms.size() == 2) return fused_entries<2>(terms, row_start_, pairs_, h);
+    if (!pairs_.empty() && terms.size() == 3) return fused_entries<3>(terms, row_start_, pairs_, h);
     for (const Term& t : terms) multiply_add(t.f, t.g, t.scale, h);
     return;
   }

@@ -89,10 +89,10 @@ class BernsteinProduct {
   // (exactly) where i < j: about half the pairs, and a convex combination as before.
   std::vector<int> square_row_start_;
   std::vector<Pair> square_pairs_;
+  // The entry kernel, N terms per walk over the given rows (pairs_ or square_pairs_).
   template <std::size_t N>
-  void fused_entries(std::span<const Term> terms, double* h) const;
-  template <std::size_t N>
-  void fused_squares(std::span<const Term> terms, double* h) const;
+  void fused_entries(std::span<const Term> terms, const std::vector<int>& row_start,
+                     const std::vector<Pair>& pair_list, double* h) const;
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
   // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k. Every
