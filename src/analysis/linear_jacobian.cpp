@@ -239,15 +239,16 @@ inline Lanes next_down_finite(Lanes x) {
 // LinearFastPath.ChunkBoundsAreTheDocumentedOutwardRoundedValues checks); only the final
 // stores are per element.
 template <LinearKind kKind>
-void decide_chunk(const double* soa, std::size_t count, JacobianBounds* out, bool* decided, const double* margins) {
+void decide_chunk(const double* soa, std::size_t row, std::size_t count, JacobianBounds* out, bool* decided,
+                  const double* margins) {
   constexpr int n = num_coefficients(kKind);
   for (std::size_t e = 0; e < count; e += kLanes) {
     const auto point = [&](int v) {
-      const double* q = soa + static_cast<std::size_t>(v) * 3 * kLinearRow + e;
+      const double* q = soa + static_cast<std::size_t>(v) * 3 * row + e;
       Vec3<Lanes> r;
       std::memcpy(&r.x, q, sizeof(Lanes));
-      std::memcpy(&r.y, q + kLinearRow, sizeof(Lanes));
-      std::memcpy(&r.z, q + 2 * kLinearRow, sizeof(Lanes));
+      std::memcpy(&r.y, q + row, sizeof(Lanes));
+      std::memcpy(&r.z, q + 2 * row, sizeof(Lanes));
       return r;
     };
     Lanes c[n];
@@ -350,13 +351,13 @@ double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double
 }
 
 void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,
-                           JacobianBounds* out, bool* decided, const double* margins) noexcept {
+                           JacobianBounds* out, bool* decided, const double* margins, std::size_t row) noexcept {
   switch (kind) {
-    case LinearKind::hexahedron: return decide_chunk<LinearKind::hexahedron>(soa, count, out, decided, margins);
-    case LinearKind::quadrangle: return decide_chunk<LinearKind::quadrangle>(soa, count, out, decided, margins);
-    case LinearKind::tetrahedron: return decide_chunk<LinearKind::tetrahedron>(soa, count, out, decided, margins);
-    case LinearKind::triangle: return decide_chunk<LinearKind::triangle>(soa, count, out, decided, margins);
-    case LinearKind::pyramid: return decide_chunk<LinearKind::pyramid>(soa, count, out, decided, margins);
+    case LinearKind::hexahedron: return decide_chunk<LinearKind::hexahedron>(soa, row, count, out, decided, margins);
+    case LinearKind::quadrangle: return decide_chunk<LinearKind::quadrangle>(soa, row, count, out, decided, margins);
+    case LinearKind::tetrahedron: return decide_chunk<LinearKind::tetrahedron>(soa, row, count, out, decided, margins);
+    case LinearKind::triangle: return decide_chunk<LinearKind::triangle>(soa, row, count, out, decided, margins);
+    case LinearKind::pyramid: return decide_chunk<LinearKind::pyramid>(soa, row, count, out, decided, margins);
     case LinearKind::none: break;
   }
   std::fill(decided, decided + count, false);

@@ -95,9 +95,9 @@ inline constexpr std::size_t kLinearRow = kLinearChunk + 8;
 double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double* coeffs) noexcept;
 
 /// The fast validity check of a chunk of first-order elements.
-/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * kLinearRow
-///                + e], #vertices * 3 * kLinearRow doubles (entries e >= count are read,
-///                in groups of 8, and their results dropped: any values will do)
+/// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * row + e],
+///                #vertices * 3 rows (entries e >= count are read, in groups of 8, and their
+///                results dropped: any values will do)
 /// @param count   elements, at most kLinearChunk
 /// @param out     count results; out[e] is written only where decided[e]
 /// @param decided out: true where the coefficients settled the sign: valid (stage 1, all
@@ -107,7 +107,9 @@ double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double
 /// @param margins optional, kLinearChunk entries (as soa, those past count are read):
 ///                element e's J differs from its vertices' first-order J by at most
 ///                margins[e] (straight_sided.hpp), which widens err; +inf decides nothing
+/// @param row     distance between the rows of soa, >= count rounded up to a multiple of 8
 void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,
-                           JacobianBounds* out, bool* decided, const double* margins = nullptr) noexcept;
+                           JacobianBounds* out, bool* decided, const double* margins = nullptr,
+                           std::size_t row = kLinearRow) noexcept;
 
 }  // namespace quadval

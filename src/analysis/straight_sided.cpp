@@ -20,7 +20,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kStraight = 1e-9;  // deviation / edge below which an element counts as straight
 constexpr double kUnderflow = 0x1p-1000;
 
-constexpr int kLanes = 8;  // elements side by side (lane_vector.hpp, also vabs and vmax)
+constexpr std::size_t kLanes = 8;  // elements side by side (lane_vector.hpp, also vabs and vmax)
 // The first-order kind of a curved type's vertices (pyramids excluded: Bergot's
 // first-order map is not in the space of the higher orders' maps).
 LinearKind vertex_kind(const ElementType& type, bool planar) noexcept {
@@ -92,18 +92,12 @@ StraightSidedMargin::StraightSidedMargin(const ElementType& type, const Jacobian
   deviation_error_ = 2 * (num_vertices_ + 14) * kUnit;
 }
 
-template <int W>
-void StraightSidedMargin::lane_margins(const double* nodes, std::size_t stride, double* out,
-                                       double* beta_out) const noexcept {
+template <int W, class At>
+void StraightSidedMargin::lane_margins(const At& at, double* out, double* beta_out) const noexcept {
   using V = Lanes<W>;
   const auto nn = static_cast<std::size_t>(num_nodes_);
   const auto nv = static_cast<std::size_t>(num_vertices_);
   const auto axes = static_cast<std::size_t>(axes_);
-  const auto at = [&](std::size_t i, std::size_t j) {  // coordinate j of node i, every lane
-    V v;
-    for (std::size_t l = 0; l < W; ++l) v[l] = nodes[l * stride + i * 3 + j];
-    return v;
-  };
   // y_v = x_v - x_0 of the vertices, and sum_v |y_v| per axis.
   V x0[3], y[8][3], vertex_sum[3] = {};
   for (std::size_t j = 0; j < axes; ++j) x0[j] = at(0, j);
@@ -172,27 +166,25 @@ void StraightSidedMargin::lane_margins(const double* nodes, std::size_t stride, 
   }
 }
 
-// One element in two lanes (stride 0): see lane_vector.hpp on one-lane vectors.
+// One element in two lanes: see lane_vector.hpp on one-lane vectors.
 double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& beta) const noexcept {
   if (kind_ == LinearKind::none) return kInf;
   double m[2] = {kInf, kInf}, b[6] = {};
-  lane_margins<2>(nodes, 0, m, b);
+  lane_margins<2>([nodes](std::size_t i, std::size_t j) { return broadcast_lanes<2>(nodes[i * 3 + j]); }, m, b);
   std::copy_n(b, 3, beta.begin());
   return m[0];
 }
 
-void StraightSidedMargin::margins(const double* nodes, std::size_t count, double* out) const noexcept {
+// Whole lane blocks read straight from the rows (a block past `count` is read whole).
+void StraightSidedMargin::margins(const double* soa, std::size_t row, std::size_t count, double* out) const noexcept {
   if (kind_ == LinearKind::none) {
     std::fill(out, out + count, kInf);
     return;
   }
-  const std::size_t stride = static_cast<std::size_t>(num_nodes_) * 3;
-  std::size_t e = 0;
-  for (; e + kLanes <= count; e += kLanes) lane_margins<kLanes>(nodes + e * stride, stride, out + e);
-  for (; e < count; ++e) {  // one element in two lanes, as in margin()
-    double m[2];
-    lane_margins<2>(nodes + e * stride, 0, m);
-    out[e] = m[0];
+  for (std::size_t e = 0; e < count; e += kLanes) {
+    double m[kLanes];
+    lane_margins<kLanes>([&](std::size_t i, std::size_t j) { return load_lanes<kLanes>(soa + (i * 3 + j) * row + e); }, m);
+    std::copy_n(m, std::min(kLanes, count - e), out + e);
   }
 }
 

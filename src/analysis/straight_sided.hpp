@@ -53,8 +53,12 @@ class StraightSidedMargin {
 
   /// m with |J - J_1| <= m on the whole element, or +inf when the element is not straight
   /// to 1e-9 (relative to its edges) or a coordinate is not finite; for `count` elements.
-  /// @param nodes count x #nodes x 3, Gmsh node order; @param out count margins
-  void margins(const double* nodes, std::size_t count, double* out) const noexcept;
+  /// @param soa   coordinates by node, axis, element: soa[(i * 3 + axis) * row + e] (Gmsh
+  ///              node order; 2D: the z rows are not read). Entries e >= count up to a
+  ///              multiple of 8 are read and their results dropped: any values will do.
+  /// @param row   distance between rows, >= count rounded up to a multiple of 8
+  /// @param out   count margins
+  void margins(const double* soa, std::size_t row, std::size_t count, double* out) const noexcept;
 
   /// One element: its margin as above and beta_c >= |D_c| everywhere, the distance of
   /// column c of the Jacobian matrix from the first-order element's (meaningless where the
@@ -62,10 +66,10 @@ class StraightSidedMargin {
   double margin(const double* nodes, std::array<double, 3>& beta) const noexcept;
 
  private:
-  // W elements at once, lane l's nodes at nodes + l * stride (stride 0: one element in
-  // every lane); beta (W x 3, optional) receives beta_c per lane.
-  template <int W>
-  void lane_margins(const double* nodes, std::size_t stride, double* out, double* beta = nullptr) const noexcept;
+  // W elements at once; at(i, j) gives coordinate j of node i in every lane; beta (W x 3,
+  // optional) receives beta_c per lane.
+  template <int W, class At>
+  void lane_margins(const At& at, double* out, double* beta = nullptr) const noexcept;
 
   // A node other than the vertices: its first-order shape values N_v != 0, v >= 1 (the
   // term of vertex 0 is 0: coordinates are taken relative to it).

@@ -391,6 +391,26 @@ TEST(CheckStream, CoordinateChecksAndPlanarTest) {
   EXPECT_THROW(check_mesh(wide, o, "wide.msh"), InputError);
   wide.coords[13] = 5e39;
   EXPECT_NO_THROW(check_mesh(wide, o, "wide.msh"));
+
+  // Past 8 nodes the pass reads blocks of 8 triples, then a tail: 45 nodes (5 blocks and 5
+  // triples), unused nodes added on the plane. Every coordinate, in a block or the tail,
+  // is seen, on its own axis.
+  Mesh many = mesh;
+  many.coords[14] = 2;
+  for (int k = 0; k < 40; ++k) {
+    many.node_tags.push_back(6 + k);
+    many.coords.insert(many.coords.end(), {0.5, 0.5, 2});
+  }
+  EXPECT_TRUE(check_mesh(many, o, "many.msh").planar);
+  for (std::size_t at = 0; at < many.coords.size(); at += 1) {
+    Mesh m = many;
+    m.coords[at] = std::numeric_limits<double>::infinity();
+    EXPECT_THROW(check_mesh(m, o, "bad.msh"), InputError) << "infinity at " << at;
+    m.coords[at] = 3e40;  // a span beyond 1e40 on that axis alone
+    EXPECT_THROW(check_mesh(m, o, "wide.msh"), InputError) << "3e40 at " << at;
+    m.coords[at] = at % 3 == 2 ? 2 : 0.5;
+    EXPECT_NO_THROW(check_mesh(m, o, "fine.msh")) << at;
+  }
 }
 
 }  // namespace

@@ -60,6 +60,20 @@ std::vector<double> straight_element(const ElementType& type, double vertex_nois
   return x;
 }
 
+// StraightSidedMargin::margins of `count` elements given node by node (count x #nodes x 3),
+// through the rows it reads (soa[(i * 3 + axis) * row + e]); the lanes past count hold NaN.
+std::vector<double> margins_of(const StraightSidedMargin& straight, const ElementType& type,
+                               const std::vector<double>& nodes, std::size_t count) {
+  const auto nn = static_cast<std::size_t>(type.num_nodes);
+  const std::size_t row = (count + 7) / 8 * 8;
+  std::vector<double> soa(nn * 3 * row, std::nan(""));
+  for (std::size_t e = 0; e < count; ++e)
+    for (std::size_t k = 0; k < nn * 3; ++k) soa[k * row + e] = nodes[e * nn * 3 + k];
+  std::vector<double> m(count);
+  straight.margins(soa.data(), row, count, m.data());
+  return m;
+}
+
 TEST(StraightSided, MarginBoundsJMinusTheFirstOrderJ) {
   std::mt19937 rng(11);
   for (const ElementType* type : straight_types()) {
@@ -72,8 +86,7 @@ TEST(StraightSided, MarginBoundsJMinusTheFirstOrderJ) {
       double worst_ratio = 0;  // largest |J - J_1| / margin seen
       for (int e = 0; e < 20; ++e) {
         const std::vector<double> x = straight_element(*type, 0.15, deviation, rng);
-        double m = 0;
-        straight.margins(x.data(), 1, &m);
+        const double m = margins_of(straight, *type, x, 1)[0];
         ASSERT_TRUE(std::isfinite(m)) << type->name << " deviation " << deviation;
         const std::vector<double> vertices(x.begin(), x.begin() + 3 * lin.num_nodes);
         for (const RefPoint& p : points) {
@@ -130,6 +143,27 @@ TEST(StraightSided, BetaBoundsTheColumnsDistanceFromTheFirstOrderColumns) {
   }
 }
 
+// A lane block's margins are each element's own: margin() (one element) bit for bit, for
+// straight and curved elements mixed in blocks and a tail.
+TEST(StraightSided, BlockMarginsEqualOneElementMargins) {
+  std::mt19937 rng(15);
+  for (const ElementType* type : straight_types()) {
+    const StraightSidedMargin straight(*type, jacobian_space(*type), true);
+    std::vector<double> nodes;
+    for (int e = 0; e < 19; ++e) {
+      const std::vector<double> x = straight_element(*type, 0.15, e % 5 == 0 ? 1e-6 : 1e-12 * e, rng);
+      nodes.insert(nodes.end(), x.begin(), x.end());
+    }
+    const std::vector<double> m = margins_of(straight, *type, nodes, 19);
+    const auto stride = static_cast<std::size_t>(type->num_nodes) * 3;
+    for (std::size_t e = 0; e < 19; ++e) {
+      std::array<double, 3> beta{};
+      EXPECT_EQ(m[e], straight.margin(nodes.data() + e * stride, beta)) << type->name << " element " << e;
+      EXPECT_EQ(std::isfinite(m[e]), e % 5 != 0) << type->name << " element " << e;
+    }
+  }
+}
+
 TEST(StraightSided, CurvedOrNonFiniteElementsGetNoMargin) {
   std::mt19937 rng(12);
   constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -147,8 +181,7 @@ TEST(StraightSided, CurvedOrNonFiniteElementsGetNoMargin) {
     nodes[3 * stride + last] = std::nan("");
     nodes[5 * stride + last + 1] = kInf;
     nodes[8 * stride + 1] = std::nan("");
-    std::vector<double> m(9);
-    straight.margins(nodes.data(), 9, m.data());
+    const std::vector<double> m = margins_of(straight, *type, nodes, 9);
     for (int e : {0, 3, 5, 8}) EXPECT_EQ(m[static_cast<std::size_t>(e)], kInf) << type->name << " element " << e;
     for (int e : {1, 2, 4, 6, 7}) EXPECT_TRUE(std::isfinite(m[static_cast<std::size_t>(e)])) << type->name << " element " << e;
   }
