@@ -485,29 +485,31 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               const JacobianSpace& space = jacobian_space(type);
               const auto s = static_cast<std::size_t>(space.basis().size());
               // Validity: straight-sided elements first, by the first-order fast path with
-              // a margin (straight_sided.hpp), from the chunk's coordinates by node and axis
-              // (rows of kRow, read a lane block at a time); the rest, listed in `rest`, go
-              // on below with their nodes element by element.
+              // a margin (straight_sided.hpp), from the mesh: their vertices by vertex and
+              // axis (rows of kRow); the rest, listed in `rest`, go on below with their nodes
+              // element by element.
               std::size_t left = 0;
               rest.resize(ch.count);
               if (const StraightSidedMargin* straight = straight_of[ch.block].get()) {
                 const std::uint64_t ts = stage_ticks();
-                constexpr std::size_t kRow = kChunk + 8;  // rows a cache line apart beyond the chunk
-                const std::size_t axes = type.dim == 2 ? 2 : 3;  // planar 2D reads x and y
-                soa.resize(nn * 3 * kRow);
                 const double* coords = mesh.coords.data();
-                for (std::size_t k = 0; k < nn; ++k) {
-                  const NodeIndex* conn = blk.element(ch.first).data() + k;
-                  double* to = soa.data() + k * 3 * kRow;
-                  for (std::size_t i = 0; i < ch.count; ++i, conn += nn) {
-                    const double* x = coords + 3 * static_cast<std::size_t>(*conn);
-                    for (std::size_t j = 0; j < axes; ++j) to[j * kRow + i] = x[j];
-                  }
-                }
+                const NodeIndex* first_conn = blk.element(ch.first).data();
                 margins.resize(kChunk);
-                straight->margins(soa.data(), kRow, ch.count, margins.data());
+                straight->margins(coords, first_conn, ch.count, margins.data());
                 if (std::any_of(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(ch.count),
                                 [](double m) { return std::isfinite(m); })) {
+                  constexpr std::size_t kRow = kChunk + 8;  // rows a cache line apart beyond the chunk
+                  const auto nv = static_cast<std::size_t>(linear_num_vertices(straight->kind()));
+                  const std::size_t axes = type.dim == 2 ? 2 : 3;  // planar 2D reads x and y
+                  soa.resize(nv * 3 * kRow);
+                  for (std::size_t v = 0; v < nv; ++v) {
+                    const NodeIndex* conn = first_conn + v;
+                    double* to = soa.data() + v * 3 * kRow;
+                    for (std::size_t i = 0; i < ch.count; ++i, conn += nn) {
+                      const double* x = coords + 3 * static_cast<std::size_t>(*conn);
+                      for (std::size_t j = 0; j < axes; ++j) to[j * kRow + i] = x[j];
+                    }
+                  }
                   fast_bounds.resize(ch.count);
                   linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
                                         margins.data(), kRow);

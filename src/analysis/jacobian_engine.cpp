@@ -141,9 +141,13 @@ MinRefinement refine_minimum(const BezierBasis& basis, const double* coeffs, dou
     if (ws.heap.empty() || halvings >= static_cast<long>(max_subdivisions) * levels) break;
     if (bisection == nullptr) {
       // Same factors and coefficient layout as the basis.
-      std::vector<FactorDegree> factors;
-      for (const BernsteinSimplex* f : basis.factors()) factors.push_back({f->dim(), f->degree()});
-      bisection = &bernstein_bisection(factors);
+      if (ws.bisection_basis != &basis) {
+        std::vector<FactorDegree> factors;
+        for (const BernsteinSimplex* f : basis.factors()) factors.push_back({f->dim(), f->degree()});
+        ws.bisection = &bernstein_bisection(factors);
+        ws.bisection_basis = &basis;
+      }
+      bisection = ws.bisection;
       levels = bisection->levels();
       ws.heap.front().state = bisection->root_state();  // the root, the only leaf so far
     }

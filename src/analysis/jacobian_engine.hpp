@@ -29,6 +29,10 @@ struct BoundsWorkspace::Impl {
   std::vector<double> pool;
   std::vector<int> free_slots;
   std::vector<Leaf> heap;
+  // The bisection of the last basis refined (a lookup per element, a key vector, a lock
+  // and a map, was a tenth of the subdivision stage on quad_h0.4_o2).
+  const BezierBasis* bisection_basis = nullptr;
+  const BernsteinBisection* bisection = nullptr;
 };
 
 /// Result of refining the minimum of a polynomial given by Bézier coefficients.

@@ -72,6 +72,13 @@ mpq_class frac(long n, long d) {
   return q;
 }
 
+// Multi-indices of degree n in d + 1 components: binomial(n + d, d).
+int simplex_size(int d, int n) {
+  int size = 1;
+  for (int k = 1; k <= d; ++k) size = size * (n + k) / k;  // exact at every step
+  return size;
+}
+
 // A Gmsh reference coordinate snapped to the order-p lattice (numerator over p).
 int snap(double x, int p, bool interval) {
   const double t = interval ? (x + 1) * 0.5 * p : x * p;
@@ -87,7 +94,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
     : type_(&type), basis_(&basis), dim_(type.dim), order_(type.order) {
   if (type.family == ElementFamily::pyramid) {
     init_pyramid(source);  // src/analysis/pyramid_space.cpp
-    build_kernel_tables();
+    build_sparse_rows();
     return;
   }
   const auto shapes = factor_shapes(type.family);
@@ -110,7 +117,7 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
     s.total = 1;
     for (int h = 0; h < 3; ++h) {
       const auto hs = static_cast<std::size_t>(h);
-      s.size[hs] = h < num_factors_ ? static_cast<int>(simplex_multi_indices(factor_dim_[hs], degree[hs]).size()) : 1;
+      s.size[hs] = h < num_factors_ ? simplex_size(factor_dim_[hs], degree[hs]) : 1;
       s.total *= s.size[hs];
     }
     return s;
@@ -136,59 +143,72 @@ JacobianProduct::JacobianProduct(const ElementType& type, const BezierBasis& bas
   const Space jspace = space_of(jdeg);
   QV_ASSERT(jspace.total == basis.size(), "J space size");
 
-  // The convolutions, and the rounding constant of the model above.
+  Space bcs;  // 3D: the space of X_eta x X_zeta
   if (dim_ == 3) {
     std::array<int, 3> bc{0, 0, 0};
     for (std::size_t h = 0; h < 3; ++h) bc[h] = deriv_space_[1].degree[h] + deriv_space_[2].degree[h];
-    const Space bcs = space_of(bc);
+    bcs = space_of(bc);
     cross_size_ = bcs.total;
-    cross_ = make_product(deriv_space_[1], deriv_space_[2], bcs);
-    dot_ = make_product(deriv_space_[0], bcs, jspace);
-    rounding_ = rounding_gamma(3 * dot_.max_terms + 2 * cross_.max_terms) + 2.01 * kUnit;
-  } else if (dim_ == 2) {
-    cross_ = make_product(deriv_space_[0], deriv_space_[1], jspace);
-    rounding_ = rounding_gamma(8 * cross_.max_terms + 8) + 2.01 * kUnit;
-  } else {
-    rounding_ = rounding_gamma(4) + 2.01 * kUnit;
-  }
-
-  // Complete types: node i sits at a lattice point.
-  if (type.complete) {
-    const auto ref = reference_nodes(type);
-    lattice_of_node_.resize(ref.size());
-    for (std::size_t i = 0; i < ref.size(); ++i) {
-      int l = 0, stride = 1;
-      for (int h = 0; h < num_factors_; ++h) {
-        const auto hs = static_cast<std::size_t>(h);
-        MultiIndex a{0, 0, 0, 0};
-        int sum = 0;
-        for (int c = 0; c < factor_dim_[hs]; ++c) {
-          a[static_cast<std::size_t>(c + 1)] =
-              snap(ref[i][static_cast<std::size_t>(factor_first_[hs] + c)], p, factor_interval_[hs]);
-          sum += a[static_cast<std::size_t>(c + 1)];
-        }
-        a[0] = p - sum;
-        l += stride * index_of(simplex_multi_indices(factor_dim_[hs], p), a);
-        stride *= lattice_.size[hs];
-      }
-      lattice_of_node_[i] = l;
-    }
   }
   maps_[0].num_nodes = type.num_nodes;
   maps_[1].num_nodes = family_num_vertices(type.family);
 
-  // The rounded tables: generated at build time for common types (product_tables.hpp),
-  // else rounded here from the exact data, which the generated path builds only when the
-  // exact fallback first asks for it (exact_coefficients).
+  // The tables: generated at build time for common types (product_tables.hpp), else made
+  // here, the rounded ones from the exact data, which the generated path builds only when
+  // the exact fallback first asks for it (exact_coefficients).
   const ProductTableView* generated =
       source == TableSource::generated_or_exact ? generated_product_tables(type.gmsh_id) : nullptr;
   if (generated != nullptr) {
     load_tables(*generated);
+    if (cross_gather_.first.empty()) build_products(bcs, jspace);  // not generated (large)
   } else {
+    build_products(bcs, jspace);
+    if (type.complete) build_lattice_of_node();
     build_exact();
     build_rounded_tables();
   }
-  build_kernel_tables();
+  build_sparse_rows();
+}
+
+void JacobianProduct::build_products(const Space& bcs, const Space& jspace) {
+  // The convolutions, and the rounding constant of the model above.
+  if (dim_ == 3) {
+    const Product cross = make_product(deriv_space_[1], deriv_space_[2], bcs);
+    const Product dot = make_product(deriv_space_[0], bcs, jspace);
+    cross_gather_ = make_gather(cross, cross_size_);
+    dot_gather_ = make_gather(dot, jspace.total);
+    rounding_ = rounding_gamma(3 * dot.max_terms + 2 * cross.max_terms) + 2.01 * kUnit;
+  } else if (dim_ == 2) {
+    const Product cross = make_product(deriv_space_[0], deriv_space_[1], jspace);
+    cross_gather_ = make_gather(cross, jspace.total);
+    rounding_ = rounding_gamma(8 * cross.max_terms + 8) + 2.01 * kUnit;
+  } else {
+    rounding_ = rounding_gamma(4) + 2.01 * kUnit;
+  }
+}
+
+// Node i of a complete type sits at a lattice point.
+void JacobianProduct::build_lattice_of_node() {
+  const int p = order_;
+  const auto ref = reference_nodes(*type_);
+  lattice_of_node_.resize(ref.size());
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    int l = 0, stride = 1;
+    for (int h = 0; h < num_factors_; ++h) {
+      const auto hs = static_cast<std::size_t>(h);
+      MultiIndex a{0, 0, 0, 0};
+      int sum = 0;
+      for (int c = 0; c < factor_dim_[hs]; ++c) {
+        a[static_cast<std::size_t>(c + 1)] =
+            snap(ref[i][static_cast<std::size_t>(factor_first_[hs] + c)], p, factor_interval_[hs]);
+        sum += a[static_cast<std::size_t>(c + 1)];
+      }
+      a[0] = p - sum;
+      l += stride * index_of(simplex_multi_indices(factor_dim_[hs], p), a);
+      stride *= lattice_.size[hs];
+    }
+    lattice_of_node_[i] = l;
+  }
 }
 
 void JacobianProduct::build_exact() const {
@@ -282,6 +302,13 @@ ProductTables JacobianProduct::tables() const {
   }
   t.deriv_inv_mult = deriv_inv_mult_;
   t.inv_mult = inv_mult_;
+  t.rounding = rounding_;
+  t.lattice_of_node = lattice_of_node_;
+  const Gather* gathers[2] = {&cross_gather_, &dot_gather_};
+  for (std::size_t g = 0; g < 2; ++g) {
+    t.gather_first[g] = gathers[g]->first;
+    for (const auto& [a, b] : gathers[g]->terms) t.gather_terms[g].insert(t.gather_terms[g].end(), {a, b});
+  }
   return t;
 }
 
@@ -304,6 +331,26 @@ void JacobianProduct::load_tables(const ProductTableView& g) {
     deriv_inv_mult_[cs] = expect_size(g.deriv_inv_mult[cs], static_cast<std::size_t>(deriv_space_[cs].total));
   }
   inv_mult_ = expect_size(g.inv_mult, static_cast<std::size_t>(basis_->size()));
+  rounding_ = g.rounding;
+  lattice_of_node_.assign(g.lattice_of_node.begin(), g.lattice_of_node.end());
+  QV_ASSERT(lattice_of_node_.size() == (type_->complete && type_->family != ElementFamily::pyramid
+                                            ? static_cast<std::size_t>(type_->num_nodes) : 0),
+            "generated tables of " << type_->name << ": lattice of the nodes");
+  Gather* gathers[2] = {&cross_gather_, &dot_gather_};
+  const int outputs[2] = {dim_ == 3 ? cross_size_ : basis_->size(), dim_ == 3 ? basis_->size() : 0};
+  // Gathers: none generated for large types (the constructor builds them), else both.
+  for (std::size_t k = 0; k < 2 && !g.gather_first[0].empty(); ++k) {
+    Gather& gather = *gathers[k];
+    const std::span<const int> first = g.gather_first[k];
+    const std::span<const int> terms = g.gather_terms[k];
+    const bool used = k == 0 ? dim_ >= 2 : dim_ == 3;
+    QV_ASSERT(used ? first.size() == static_cast<std::size_t>(outputs[k]) + 1 && first.back() * 2 == static_cast<int>(terms.size())
+                   : first.empty() && terms.empty(),
+              "generated tables of " << type_->name << ": gather " << k);
+    gather.first.assign(first.begin(), first.end());
+    gather.terms.resize(terms.size() / 2);
+    for (std::size_t t = 0; t < gather.terms.size(); ++t) gather.terms[t] = {terms[2 * t], terms[2 * t + 1]};
+  }
 }
 
 JacobianProduct::Product JacobianProduct::make_product(const Space& a, const Space& b,
@@ -347,6 +394,13 @@ JacobianProduct::Product JacobianProduct::make_product(const Space& a, const Spa
     p.max_terms *= *std::max_element(terms.begin(), terms.end());
   }
   return p;
+}
+
+template <class F>
+void JacobianProduct::for_each_term(const Gather& g, F&& f) {
+  for (std::size_t k = 0; k + 1 < g.first.size(); ++k)
+    for (int t = g.first[k]; t < g.first[k + 1]; ++t)
+      f(g.terms[static_cast<std::size_t>(t)][0], g.terms[static_cast<std::size_t>(t)][1], static_cast<int>(k));
 }
 
 template <class F>
@@ -548,13 +602,7 @@ JacobianProduct::Gather JacobianProduct::make_gather(const Product& p, int outpu
   return g;
 }
 
-void JacobianProduct::build_kernel_tables() {
-  if (dim_ == 3) {
-    cross_gather_ = make_gather(cross_, cross_size_);
-    dot_gather_ = make_gather(dot_, basis_->size());
-  } else if (dim_ == 2) {
-    cross_gather_ = make_gather(cross_, basis_->size());
-  }
+void JacobianProduct::build_sparse_rows() {
   for (Map& map : maps_) {
     const auto n = static_cast<std::size_t>(map.num_nodes);
     for (int c = 0; c < dim_; ++c) {
@@ -828,20 +876,20 @@ std::vector<mpq_class> JacobianProduct::exact_coefficients(SampleMap which, cons
     const auto kc = static_cast<std::size_t>(cross_size_);
     std::array<std::vector<mpq_class>, 3> cr;
     for (auto& v : cr) v.assign(kc, mpq_class(0));
-    for_each_term(cross_, [&](int ib, int ic, int im) {
+    for_each_term(cross_gather_, [&](int ib, int ic, int im) {
       const auto b = static_cast<std::size_t>(ib), c = static_cast<std::size_t>(ic), m = static_cast<std::size_t>(im);
       cr[0][m] += d[1][1][b] * d[2][2][c] - d[1][2][b] * d[2][1][c];
       cr[1][m] += d[1][2][b] * d[2][0][c] - d[1][0][b] * d[2][2][c];
       cr[2][m] += d[1][0][b] * d[2][1][c] - d[1][1][b] * d[2][0][c];
     });
-    for_each_term(dot_, [&](int ia, int im, int ik) {
+    for_each_term(dot_gather_, [&](int ia, int im, int ik) {
       const auto a = static_cast<std::size_t>(ia), m = static_cast<std::size_t>(im);
       out[static_cast<std::size_t>(ik)] += d[0][0][a] * cr[0][m] + d[0][1][a] * cr[1][m] + d[0][2][a] * cr[2][m];
     });
   } else if (dim_ == 2) {
     const mpq_class n0(r[0]), n1(r[1]), n2(r[2]);
     const mpq_class nz = planar ? mpq_class(1) : n2;
-    for_each_term(cross_, [&](int ia, int ib, int ik) {
+    for_each_term(cross_gather_, [&](int ia, int ib, int ik) {
       const auto a = static_cast<std::size_t>(ia), b = static_cast<std::size_t>(ib);
       mpq_class v = nz * (d[0][0][a] * d[1][1][b] - d[0][1][a] * d[1][0][b]);
       if (!planar)

@@ -36,9 +36,9 @@ struct PyramidShapeCoefficients;  // pyramid_space.hpp
 /// Which geometry to use: the element's own map, or its straight-sided element's.
 enum class SampleMap { curved, straight };
 
-/// The rounded tables of a JacobianProduct: everything its double arithmetic reads that
-/// is rounded from exact rationals. Generated at build time for common types
-/// (product_tables.hpp), else rounded when the product is built.
+/// The tables of a JacobianProduct: everything its double arithmetic reads that is rounded
+/// from exact rationals, and the index tables of its kernel. Generated at build time for
+/// common types (product_tables.hpp), else made when the product is built.
 struct ProductTables {
   struct MapTables {
     int num_nodes = 0;
@@ -48,6 +48,11 @@ struct ProductTables {
   std::array<MapTables, 2> maps;                   ///< SampleMap::curved, SampleMap::straight
   std::array<std::vector<double>, 3> deriv_inv_mult;  ///< 1 / mult(k) of each derivative space
   std::vector<double> inv_mult;                    ///< 1 / mult(gamma) of the J space
+  double rounding = 0;                             ///< relative rounding of the products
+  std::vector<int> lattice_of_node;                ///< complete types: lattice index of node i
+  /// The convolutions by output (0: the cross product, 1: 3D's dot product): offsets
+  /// (outputs + 1) into the terms, and the terms' inputs (a, b), flattened, in summation order.
+  std::array<std::vector<int>, 2> gather_first, gather_terms;
 };
 
 struct ProductTableView;  // product_tables.hpp
@@ -145,7 +150,13 @@ class JacobianProduct {
 
   Product make_product(const Space& a, const Space& b, const Space& c) const;
   template <class F>
-  static void for_each_term(const Product& p, F&& f);
+  static void for_each_term(const Product& p, F&& f);  // f(a, b, c) per term
+  template <class F>
+  static void for_each_term(const Gather& g, F&& f);  // the same terms, by output
+  // The gathers and the rounding constant from the convolutions (bcs: 3D's cross product
+  // space; jspace: the J space).
+  void build_products(const Space& bcs, const Space& jspace);
+  void build_lattice_of_node();  // complete types
   void build_exact() const;       // the exact data below, once (thread-safe)
   void build_exact_data() const;  // factor_matrix_, mult_, to_lattice
   void build_lattice_values(SampleMap which) const;
@@ -153,7 +164,7 @@ class JacobianProduct {
   void build_map_tables(SampleMap which);
   void load_tables(const ProductTableView& generated);
   Gather make_gather(const Product& p, int outputs) const;
-  void build_kernel_tables();  // gathers and sparse rows, once the products and maps exist
+  void build_sparse_rows();  // from the maps' matrices
   // coefficients() of W consecutive elements (lanes), all arrays lane-fastest in buf.
   template <int W>
   void lane_block(const Map& map, const double* nodes, std::size_t stride, bool planar,
@@ -186,10 +197,10 @@ class JacobianProduct {
   // exact per-factor derivative maps: factor_matrix_[c][h] is rows x lattice size of factor h
   mutable std::array<std::array<std::vector<mpq_class>, 3>, 3> factor_matrix_;
   std::vector<int> lattice_of_node_;  // complete types: lattice index of node i
-  Product cross_;  // 3D: X_eta x X_zeta; 2D: X_xi x X_eta (then J)
   int cross_size_ = 0;  // 3D: coefficients of each component of X_eta x X_zeta
-  Product dot_;    // 3D: X_xi . (X_eta x X_zeta)
-  Gather cross_gather_, dot_gather_;  // cross_ and dot_ by output, same summation order
+  // The convolutions by output: 3D: X_eta x X_zeta, then X_xi . (X_eta x X_zeta); 2D:
+  // X_xi x X_eta (then J).
+  Gather cross_gather_, dot_gather_;
   double rounding_ = 0;  // relative rounding of the products and the final scaling
   mutable std::array<Map, 2> maps_;  // mutable for Map::to_lattice, Map::pyramid (build_exact)
 };

@@ -1,8 +1,10 @@
 #pragma once
-// Rounded Bernstein-product tables (jacobian_product.hpp) made at build time, so that the
-// first use of a common element type costs no exact (GMP) arithmetic: `quadval check` on a
-// small mesh would otherwise spend most of its time building them (milliseconds per type
-// against microseconds for the elements). Internal to src/analysis.
+// Bernstein-product tables (jacobian_product.hpp) made at build time, so that the first use
+// of a common element type costs no exact (GMP) arithmetic and builds no convolution:
+// `quadval check` on a small mesh would otherwise spend most of its time building them
+// (milliseconds per type against microseconds for the elements; with the rounded tables
+// alone, the convolutions' index tables and the lattice of the nodes were still about 20
+// us of a 160 us check of quad_h0.4_o2). Internal to src/analysis.
 //
 // tools/gen_product_tables.cpp builds each type's JacobianProduct in exact arithmetic
 // (TableSource::exact), the same code path as any other type, and writes its tables as
@@ -15,7 +17,8 @@
 namespace quadval {
 
 /// One type's tables: the fields of ProductTables (jacobian_product.hpp) as views of
-/// static arrays; index m is SampleMap (0 curved, 1 straight), c the direction.
+/// static arrays; index m is SampleMap (0 curved, 1 straight), c the direction, g the
+/// convolution (0 cross, 1 dot).
 struct ProductTableView {
   int gmsh_id = 0;
   int num_nodes[2] = {0, 0};
@@ -23,6 +26,9 @@ struct ProductTableView {
   double row_sum[2][3] = {};
   std::span<const double> deriv_inv_mult[3];
   std::span<const double> inv_mult;
+  double rounding = 0;
+  std::span<const int> lattice_of_node;
+  std::span<const int> gather_first[2], gather_terms[2];
 };
 
 /// The generated tables of a Gmsh type id, or nullptr when none were generated.

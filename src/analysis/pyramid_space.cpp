@@ -268,9 +268,6 @@ void JacobianProduct::init_pyramid(TableSource source) {
   for (std::size_t h = 0; h < 3; ++h) bc[h] = deriv_space_[1].degree[h] + deriv_space_[2].degree[h];
   const Space bcs = space_of(bc);
   cross_size_ = bcs.total;
-  cross_ = make_product(deriv_space_[1], deriv_space_[2], bcs);
-  dot_ = make_product(deriv_space_[0], bcs, jspace);
-  rounding_ = rounding_gamma(3 * dot_.max_terms + 2 * cross_.max_terms) + 2.01 * 0x1p-53;
   maps_[static_cast<std::size_t>(SampleMap::curved)].num_nodes = type.num_nodes;
   maps_[static_cast<std::size_t>(SampleMap::straight)].num_nodes = 5;
 
@@ -280,7 +277,9 @@ void JacobianProduct::init_pyramid(TableSource source) {
       source == TableSource::generated_or_exact ? generated_product_tables(type.gmsh_id) : nullptr;
   if (generated != nullptr) {
     load_tables(*generated);
+    if (cross_gather_.first.empty()) build_products(bcs, jspace);  // not generated (large)
   } else {
+    build_products(bcs, jspace);
     build_exact();
     build_pyramid_rounded_tables();
   }

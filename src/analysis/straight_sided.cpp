@@ -175,15 +175,26 @@ double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& b
   return m[0];
 }
 
-// Whole lane blocks read straight from the rows (a block past `count` is read whole).
-void StraightSidedMargin::margins(const double* soa, std::size_t row, std::size_t count, double* out) const noexcept {
+// Lane blocks gathered from the mesh, a node when it is needed: a block of curved elements
+// stops at its first high-order node. A tail block repeats its last element.
+void StraightSidedMargin::margins(const double* coords, const NodeIndex* conn, std::size_t count,
+                                  double* out) const noexcept {
   if (kind_ == LinearKind::none) {
     std::fill(out, out + count, kInf);
     return;
   }
+  const auto nn = static_cast<std::size_t>(num_nodes_);
   for (std::size_t e = 0; e < count; e += kLanes) {
+    const NodeIndex* lane[kLanes];
+    for (std::size_t l = 0; l < kLanes; ++l) lane[l] = conn + std::min(e + l, count - 1) * nn;
     double m[kLanes];
-    lane_margins<kLanes>([&](std::size_t i, std::size_t j) { return load_lanes<kLanes>(soa + (i * 3 + j) * row + e); }, m);
+    lane_margins<kLanes>(
+        [&](std::size_t i, std::size_t j) {
+          Lanes<kLanes> v;
+          for (std::size_t l = 0; l < kLanes; ++l) v[l] = coords[3 * static_cast<std::size_t>(lane[l][i]) + j];
+          return v;
+        },
+        m);
     std::copy_n(m, std::min(kLanes, count - e), out + e);
   }
 }

@@ -39,6 +39,7 @@
 
 #include "analysis/jacobian_space.hpp"
 #include "analysis/linear_jacobian.hpp"
+#include "quadval/mesh.hpp"
 
 namespace quadval {
 
@@ -52,13 +53,11 @@ class StraightSidedMargin {
   LinearKind kind() const noexcept { return kind_; }
 
   /// m with |J - J_1| <= m on the whole element, or +inf when the element is not straight
-  /// to 1e-9 (relative to its edges) or a coordinate is not finite; for `count` elements.
-  /// @param soa   coordinates by node, axis, element: soa[(i * 3 + axis) * row + e] (Gmsh
-  ///              node order; 2D: the z rows are not read). Entries e >= count up to a
-  ///              multiple of 8 are read and their results dropped: any values will do.
-  /// @param row   distance between rows, >= count rounded up to a multiple of 8
-  /// @param out   count margins
-  void margins(const double* soa, std::size_t row, std::size_t count, double* out) const noexcept;
+  /// to 1e-9 (relative to its edges) or a coordinate is not finite; for `count` elements,
+  /// read from the mesh: element e's node i at coords + 3 * conn[e * #nodes + i] (Gmsh node
+  /// order). A curved element's nodes are read only up to the first that shows it curved.
+  /// @param out count margins
+  void margins(const double* coords, const NodeIndex* conn, std::size_t count, double* out) const noexcept;
 
   /// One element: its margin as above and beta_c >= |D_c| everywhere, the distance of
   /// column c of the Jacobian matrix from the first-order element's (meaningless where the

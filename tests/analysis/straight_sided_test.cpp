@@ -61,16 +61,21 @@ std::vector<double> straight_element(const ElementType& type, double vertex_nois
 }
 
 // StraightSidedMargin::margins of `count` elements given node by node (count x #nodes x 3),
-// through the rows it reads (soa[(i * 3 + axis) * row + e]); the lanes past count hold NaN.
+// as a mesh whose nodes are listed in reverse, so that an element's connectivity differs
+// from its position.
 std::vector<double> margins_of(const StraightSidedMargin& straight, const ElementType& type,
                                const std::vector<double>& nodes, std::size_t count) {
-  const auto nn = static_cast<std::size_t>(type.num_nodes);
-  const std::size_t row = (count + 7) / 8 * 8;
-  std::vector<double> soa(nn * 3 * row, std::nan(""));
-  for (std::size_t e = 0; e < count; ++e)
-    for (std::size_t k = 0; k < nn * 3; ++k) soa[k * row + e] = nodes[e * nn * 3 + k];
+  const std::size_t total = nodes.size() / 3;
+  std::vector<double> coords(nodes.size());
+  std::vector<NodeIndex> conn(total);
+  for (std::size_t k = 0; k < total; ++k) {
+    conn[k] = static_cast<NodeIndex>(total - 1 - k);
+    std::copy_n(nodes.begin() + static_cast<std::ptrdiff_t>(3 * k), 3,
+                coords.begin() + static_cast<std::ptrdiff_t>(3 * conn[k]));
+  }
+  EXPECT_EQ(total, count * static_cast<std::size_t>(type.num_nodes));
   std::vector<double> m(count);
-  straight.margins(soa.data(), row, count, m.data());
+  straight.margins(coords.data(), conn.data(), count, m.data());
   return m;
 }
 
