@@ -175,8 +175,9 @@ double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& b
   return m[0];
 }
 
-// Lane blocks gathered from the mesh, a node when it is needed: a block of curved elements
-// stops at its first high-order node. A tail block repeats its last element.
+// Lane blocks gathered from the mesh a node at a time, as lane_margins asks for them (it
+// stops at the first node that shows every lane curved). A tail block repeats its last
+// element.
 void StraightSidedMargin::margins(const double* coords, const NodeIndex* conn, std::size_t count,
                                   double* out) const noexcept {
   if (kind_ == LinearKind::none) {

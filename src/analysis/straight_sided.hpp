@@ -55,7 +55,8 @@ class StraightSidedMargin {
   /// m with |J - J_1| <= m on the whole element, or +inf when the element is not straight
   /// to 1e-9 (relative to its edges) or a coordinate is not finite; for `count` elements,
   /// read from the mesh: element e's node i at coords + 3 * conn[e * #nodes + i] (Gmsh node
-  /// order). A curved element's nodes are read only up to the first that shows it curved.
+  /// order), 8 elements at a time; 8 curved ones are read only up to the first node that
+  /// shows all of them curved.
   /// @param out count margins
   void margins(const double* coords, const NodeIndex* conn, std::size_t count, double* out) const noexcept;
 
