@@ -19,11 +19,13 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <gmpxx.h>
 
 #include <map>
 #include <memory>
 #include <mutex>
+#include <numeric>
 #include <tuple>
 
 #include "bezier/rational_rounding.hpp"
@@ -52,11 +54,11 @@ mpz_class multinomial(const MultiIndex& a, int dim) {
 }
 
 // Exact weights without GMP where they fit. A weight is a ratio of products of
-// multinomials; in 128-bit integers, reduced, both parts are below 2^53 for every product
-// the analysis forms (degrees up to 36), and then their IEEE quotient is the nearest double
-// to the exact ratio, as nearest_double would round it. Anything larger goes through GMP.
-// (GMP here was most of the first mu or scaled-Jacobian check of a small mesh: about 0.25
-// ms of a 2.2 ms check of quad_h0.4_o2.)
+// multinomials, kept in 128-bit integers in lowest terms; when both parts are below 2^53
+// they are exact doubles, and their IEEE quotient is the double nearest to the exact ratio
+// (never a tie: the reduced ratio is either a double or not dyadic), as nearest_double
+// rounds it. Anything larger goes through GMP. (GMP here was about 0.25 ms of a 2.2 ms
+// first scaled-Jacobian check of quad_h0.4_o2.)
 __extension__ typedef unsigned __int128 U128;  // GCC and Clang
 
 // n! / prod alpha_a!, or 0 when it does not fit 128 bits. Each step m * n / t is exact: m
@@ -74,6 +76,8 @@ U128 multinomial128(const MultiIndex& a, int dim) {
 }
 
 U128 gcd128(U128 a, U128 b) {
+  if ((a >> 64) == 0 && (b >> 64) == 0)  // the usual case: no 128-bit division
+    return std::gcd(static_cast<std::uint64_t>(a), static_cast<std::uint64_t>(b));
   while (b != 0) {
     const U128 t = a % b;
     a = b;
@@ -215,6 +219,65 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
   f_size_ = fs;
   g_size_ = gs;
   h_size_ = hs;
+  // Small products: the grids' set-up costs more than the gathers (measured, mu_bench).
+  entries_kernel_ = static_cast<long>(f_size_) * g_size_ < kEntryKernelBelow;
+  if (entries_kernel_) {
+    // Flattened entry kernel: every (i, j) pair with its exact tensor weight, by k (a
+    // stable counting sort of the pairs in the order below).
+    std::vector<std::pair<int, Pair>> by_k;
+    by_k.reserve(static_cast<std::size_t>(f_size_) * static_cast<std::size_t>(g_size_));
+    // The exact tensor weight w0 w1 w2, with w1 w2 formed once per (a1, a2) and the unit
+    // weights of unused factors not multiplied at all (GMP products are most of the set-up).
+    for (std::size_t a2 = 0; a2 < entries_[2].size(); ++a2)
+      for (std::size_t a1 = 0; a1 < entries_[1].size(); ++a1) {
+        const Fraction w12 = times(exact_w[1][a1], exact_w[2][a2]);
+        const bool unit = w12.num == 1 && w12.den == 1;
+        for (std::size_t a0 = 0; a0 < entries_[0].size(); ++a0) {
+          const Entry& e0 = entries_[0][a0];
+          const Entry& e1 = entries_[1][a1];
+          const Entry& e2 = entries_[2][a2];
+          const int i = e0.i * f_stride_[0] + e1.i * f_stride_[1] + e2.i * f_stride_[2];
+          const int j = e0.j * g_stride_[0] + e1.j * g_stride_[1] + e2.j * g_stride_[2];
+          const int k = e0.k * h_stride_[0] + e1.k * h_stride_[1] + e2.k * h_stride_[2];
+          const double w = unit ? e0.w : nearest(times(exact_w[0][a0], w12), [&] {
+            mpq_class exact = gmp_weight(0, e0);
+            for (std::size_t fac = 1; fac < f_degrees_.size(); ++fac) exact *= gmp_weight(fac, fac == 1 ? e1 : e2);
+            return exact;
+          });
+          by_k.push_back({k, {i, j, w}});
+        }
+      }
+    row_start_.assign(static_cast<std::size_t>(h_size_) + 1, 0);
+    for (const auto& [k, q] : by_k) ++row_start_[static_cast<std::size_t>(k) + 1];
+    for (std::size_t k = 0; k < static_cast<std::size_t>(h_size_); ++k) row_start_[k + 1] += row_start_[k];
+    pairs_.resize(by_k.size());
+    std::vector<int> fill(row_start_.begin(), row_start_.end() - 1);
+    for (const auto& [k, q] : by_k) pairs_[static_cast<std::size_t>(fill[static_cast<std::size_t>(k)]++)] = q;
+    bool same_space = true;
+    for (std::size_t fac = 0; fac < f_degrees_.size(); ++fac)
+      same_space = same_space && f_degrees_[fac].degree == g_degrees_[fac].degree;
+    if (same_space) {
+      square_row_start_.push_back(0);
+      for (std::size_t k = 0; k < static_cast<std::size_t>(h_size_); ++k) {
+        const std::span<const Pair> r(pairs_.data() + row_start_[k], pairs_.data() + row_start_[k + 1]);
+        std::size_t below = 0, diagonal = 0;
+        for (const Pair& q : r) {
+          if (q.i < q.j) {
+            square_pairs_.push_back({q.i, q.j, 2 * q.w});  // exact: a power of two
+            ++below;
+          } else if (q.i == q.j) {
+            square_pairs_.push_back(q);
+            ++diagonal;
+          }
+        }
+        QV_ASSERT(2 * below + diagonal == r.size(), "a product of one space is not symmetric");
+        square_row_start_.push_back(static_cast<int>(square_pairs_.size()));
+      }
+    }
+  }
+}
+
+void BernsteinProduct::build_grids() const {
   // Grids of the convolution kernel, all addressed with the strides of h's grid.
   std::array<int, 3> hdims{1, 1, 1};
   {
@@ -279,58 +342,6 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
   f_grid_ = make_grid(f_degrees_, false);
   g_grid_ = make_grid(g_degrees_, false);
   h_grid_ = make_grid(h_degrees_, true);
-  // Small products: the grids' set-up costs more than the gathers (measured, mu_bench).
-  entries_kernel_ = static_cast<long>(f_size_) * g_size_ < kEntryKernelBelow;
-  if (entries_kernel_) {
-    // Flattened entry kernel: every (i, j) pair with its exact tensor weight, by k.
-    std::vector<std::vector<Pair>> rows(static_cast<std::size_t>(h_size_));
-    // The exact tensor weight w0 w1 w2, with w1 w2 formed once per (a1, a2) and the unit
-    // weights of unused factors not multiplied at all (GMP products are most of the set-up).
-    for (std::size_t a2 = 0; a2 < entries_[2].size(); ++a2)
-      for (std::size_t a1 = 0; a1 < entries_[1].size(); ++a1) {
-        const Fraction w12 = times(exact_w[1][a1], exact_w[2][a2]);
-        const bool unit = w12.num == 1 && w12.den == 1;
-        for (std::size_t a0 = 0; a0 < entries_[0].size(); ++a0) {
-          const Entry& e0 = entries_[0][a0];
-          const Entry& e1 = entries_[1][a1];
-          const Entry& e2 = entries_[2][a2];
-          const int i = e0.i * f_stride_[0] + e1.i * f_stride_[1] + e2.i * f_stride_[2];
-          const int j = e0.j * g_stride_[0] + e1.j * g_stride_[1] + e2.j * g_stride_[2];
-          const int k = e0.k * h_stride_[0] + e1.k * h_stride_[1] + e2.k * h_stride_[2];
-          const double w = unit ? e0.w : nearest(times(exact_w[0][a0], w12), [&] {
-            mpq_class exact = gmp_weight(0, e0);
-            for (std::size_t fac = 1; fac < f_degrees_.size(); ++fac) exact *= gmp_weight(fac, fac == 1 ? e1 : e2);
-            return exact;
-          });
-          rows[static_cast<std::size_t>(k)].push_back({i, j, w});
-        }
-      }
-    row_start_.push_back(0);
-    for (const auto& r : rows) {
-      pairs_.insert(pairs_.end(), r.begin(), r.end());
-      row_start_.push_back(static_cast<int>(pairs_.size()));
-    }
-    bool same_space = true;
-    for (std::size_t fac = 0; fac < f_degrees_.size(); ++fac)
-      same_space = same_space && f_degrees_[fac].degree == g_degrees_[fac].degree;
-    if (same_space) {
-      square_row_start_.push_back(0);
-      for (const auto& r : rows) {
-        std::size_t below = 0, diagonal = 0;
-        for (const Pair& q : r) {
-          if (q.i < q.j) {
-            square_pairs_.push_back({q.i, q.j, 2 * q.w});  // exact: a power of two
-            ++below;
-          } else if (q.i == q.j) {
-            square_pairs_.push_back(q);
-            ++diagonal;
-          }
-        }
-        QV_ASSERT(2 * below + diagonal == r.size(), "a product of one space is not symmetric");
-        square_row_start_.push_back(static_cast<int>(square_pairs_.size()));
-      }
-    }
-  }
 }
 
 void BernsteinProduct::accumulate_grid(const double* f, const double* g, double scale,
@@ -414,6 +425,7 @@ void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) 
     for (const Term& t : terms) multiply_add(t.f, t.g, t.scale, h);
     return;
   }
+  std::call_once(grids_once_, [this] { build_grids(); });
   thread_local std::vector<double> acc;
   acc.assign(static_cast<std::size_t>(h_cells_), 0.0);
   for (const Term& t : terms) accumulate_grid(t.f, t.g, t.scale, acc.data());

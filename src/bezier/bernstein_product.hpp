@@ -15,6 +15,7 @@
 // computed as the equivalent scaled convolution (error model at the top of
 // bernstein_product.cpp; the same bound).
 #include <array>
+#include <mutex>
 #include <span>
 #include <vector>
 
@@ -103,8 +104,12 @@ class BernsteinProduct {
     std::vector<double> scale;   // alpha (f, g) or 1 / alpha (h) per coefficient, rounded
     std::vector<std::array<int, 2>> runs;  // (offset, length): contiguous runs covering it
   };
-  Grid f_grid_, g_grid_, h_grid_;
-  int h_cells_ = 1;  // cells of h's grid
+  // Built on the grid kernel's first use (thread-safe): a small product never needs them
+  // (their set-up was a third of a small product's).
+  mutable std::once_flag grids_once_;
+  mutable Grid f_grid_, g_grid_, h_grid_;
+  mutable int h_cells_ = 1;  // cells of h's grid
+  void build_grids() const;
   bool entries_kernel_ = false;  // the weighted-entry loop (small products)
   // acc (h's grid) += scale * (scaled f) conv (scaled g).
   void accumulate_grid(const double* f, const double* g, double scale, double* acc) const;
