@@ -13,6 +13,7 @@
 
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
+#include "analysis/product_tables.hpp"
 #include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "bezier/rational_rounding.hpp"
@@ -239,7 +240,7 @@ void MuSpace::init_pyramid_derivatives() {
   }
 }
 
-MuSpace::MuSpace(const ElementType& type) : type_(&type) {
+MuSpace::MuSpace(const ElementType& type, TableSource source) : type_(&type) {
   QV_ASSERT(type.has_lagrange_basis && type.order >= 1 && type.order <= mu_max_order(type.family),
             "no mu space for " << type.name);
   dim_ = type.dim;
@@ -248,19 +249,43 @@ MuSpace::MuSpace(const ElementType& type) : type_(&type) {
     // W's columns are polynomials in the cube coordinates (u, v, t) (pyramid_space.hpp):
     // one tensor space of degree r per axis, subdivided like a hexahedron's.
     init_w_space({1, 1, 1}, type.order);
-    init_pyramid_derivatives();
-    return;
+  } else {
+    const auto shapes = factor_shapes(type.family);
+    QV_ASSERT(!shapes.empty(), "no mu space for " << type.name);
+    std::vector<int> dims;
+    for (const FactorShape& s : shapes) dims.push_back(s.dim);
+    init_w_space(dims, simplicial(type.family) ? type.order - 1 : type.order);
   }
+  const MuTableView* generated = source == TableSource::generated_or_exact ? generated_mu_tables(type.gmsh_id) : nullptr;
+  if (generated != nullptr) {
+    const auto size = static_cast<std::size_t>(w_basis_->size()) * static_cast<std::size_t>(num_nodes_);
+    for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c) {
+      QV_ASSERT(generated->derivative[c].size() == size, "generated mu tables of " << type.name << ": size");
+      deriv_[c].assign(generated->derivative[c].begin(), generated->derivative[c].end());
+      row_sum_[c] = generated->row_sum[c];
+    }
+  } else if (type.family == ElementFamily::pyramid) {
+    init_pyramid_derivatives();
+  } else {
+    init_derivatives();
+  }
+}
+
+MuTables MuSpace::tables() const {
+  MuTables t;
+  for (std::size_t c = 0; c < 3; ++c) {
+    t.derivative[c] = deriv_[c];
+    t.row_sum[c] = row_sum_[c];
+  }
+  return t;
+}
+
+void MuSpace::init_derivatives() {
+  const ElementType& type = *type_;
   const auto shapes = factor_shapes(type.family);
-  QV_ASSERT(!shapes.empty(), "no mu space for " << type.name);
   const int p = type.order;
   const auto nf = static_cast<int>(shapes.size());
   const bool simplex = simplicial(type.family);
-  {
-    std::vector<int> dims;
-    for (const FactorShape& s : shapes) dims.push_back(s.dim);
-    init_w_space(dims, simplex ? p - 1 : p);
-  }
 
   // Lattice of the geometry (degree p per factor) and its points' keys.
   std::vector<std::vector<MultiIndex>> geo(static_cast<std::size_t>(nf));

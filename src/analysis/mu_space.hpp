@@ -9,6 +9,7 @@
 #include <mutex>
 #include <vector>
 
+#include "analysis/jacobian_product.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
@@ -41,11 +42,22 @@ int mu_max_order(ElementFamily family) noexcept;
 /// near-degenerate element.
 int mu_certificate_max_order(ElementFamily family) noexcept;
 
+/// The rounded derivative maps of a MuSpace (what its exact set-up computes): generated at
+/// build time for common types (product_tables.hpp), else made when the space is built.
+struct MuTables {
+  std::array<std::vector<double>, 3> derivative;  ///< as MuSpace::derivative(c)
+  std::array<double, 3> row_sum{0, 0, 0};         ///< as MuSpace::derivative_row_sum(c)
+};
+
 class MuSpace {
  public:
   /// @pre type a Lagrange triangle, quadrangle, tetrahedron, prism, hexahedron or pyramid
   ///      of order 1..mu_max_order(family)
-  explicit MuSpace(const ElementType& type);
+  /// With generated tables the derivative maps cost no exact (GMP) arithmetic.
+  explicit MuSpace(const ElementType& type, TableSource source = TableSource::generated_or_exact);
+
+  /// A copy of the derivative maps (what the generator writes, and what tests compare).
+  MuTables tables() const;
 
   /// True when the certificate's data (degrees, sizes and product tables above (1, 1))
   /// were built: order <= mu_certificate_max_order(family). Otherwise only the control-
@@ -92,6 +104,8 @@ class MuSpace {
   bool certificate_ = false;
   // Pyramids: derivative maps from Bergot's exact shape functions (pyramid_space.hpp).
   void init_pyramid_derivatives();
+  // The other families: derivative maps from the geometry's exact Bézier form.
+  void init_derivatives();
 
   const ElementType* type_;
   int dim_ = 0;

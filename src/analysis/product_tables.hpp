@@ -6,8 +6,11 @@
 // alone, the convolutions' index tables and the lattice of the nodes were still about 20
 // us of a 160 us check of quad_h0.4_o2). Internal to src/analysis.
 //
-// tools/gen_product_tables.cpp builds each type's JacobianProduct in exact arithmetic
-// (TableSource::exact), the same code path as any other type, and writes its tables as
+// The same for the derivative maps of mu's space (MuSpace, mu_space.hpp): their exact set-up
+// was half of a first `check --measure mu` of tri_h0.4_o4 (about 1 ms).
+//
+// tools/gen_product_tables.cpp builds each type's JacobianProduct (and MuSpace) in exact
+// arithmetic (TableSource::exact), the same code path as any other type, and writes their tables as
 // hexadecimal float literals, which read back to the same doubles bit for bit; CMake runs
 // it and compiles the output into the library. The generator itself links
 // product_tables_none.cpp instead. tests/analysis/product_tables_test.cpp checks that the
@@ -33,6 +36,16 @@ struct ProductTableView {
 
 /// The generated tables of a Gmsh type id, or nullptr when none were generated.
 const ProductTableView* generated_product_tables(int gmsh_id) noexcept;
+
+/// One type's MuSpace derivative maps (MuTables, mu_space.hpp) as views of static arrays.
+struct MuTableView {
+  int gmsh_id = 0;
+  std::span<const double> derivative[3];
+  double row_sum[3] = {};
+};
+
+/// The generated MuSpace tables of a Gmsh type id, or nullptr when none were generated.
+const MuTableView* generated_mu_tables(int gmsh_id) noexcept;
 
 /// The ids of all generated types (for tests).
 std::span<const int> generated_product_table_ids() noexcept;

@@ -8,4 +8,6 @@ const ProductTableView* generated_product_tables(int) noexcept { return nullptr;
 
 std::span<const int> generated_product_table_ids() noexcept { return {}; }
 
+const MuTableView* generated_mu_tables(int) noexcept { return nullptr; }
+
 }  // namespace quadval

@@ -12,6 +12,7 @@
 
 #include "analysis/jacobian_product.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/mu_space.hpp"
 #include "analysis/product_tables.hpp"
 #include "jacobian_test_util.hpp"
 
@@ -82,6 +83,29 @@ TEST(ProductTables, GeneratedEqualExactlyBuiltBitForBit) {
   }
 }
 
+TEST(ProductTables, GeneratedMuTablesEqualExactlyBuiltBitForBit) {
+  int count = 0;
+  for (int id : generated_product_table_ids()) {
+    const MuTableView* view = generated_mu_tables(id);
+    if (view == nullptr) continue;
+    ++count;
+    const ElementType& type = *find_element_type(id);
+    SCOPED_TRACE(std::string(type.name));
+    const MuTables exact = MuSpace(type, TableSource::exact).tables();
+    for (const MuTables& got : {mu_space(type).tables(), MuSpace(type).tables()}) {
+      for (std::size_t c = 0; c < 3; ++c) {
+        expect_same_bits(got.derivative[c], exact.derivative[c], "derivative " + std::to_string(c));
+        expect_same_bits(std::span(&got.row_sum[c], 1), std::span(&exact.row_sum[c], 1), "row sum");
+      }
+    }
+    for (std::size_t c = 0; c < 3; ++c) {
+      expect_same_bits(view->derivative[c], exact.derivative[c], "view derivative " + std::to_string(c));
+      expect_same_bits(std::span(&view->row_sum[c], 1), std::span(&exact.row_sum[c], 1), "view row sum");
+    }
+  }
+  EXPECT_GE(count, 30);
+}
+
 TEST(ProductTables, CommonTypesAreGenerated) {
   // The types of the benchmark meshes and of everyday Gmsh output, orders 1-3 (4 in 2D),
   // pyramids included (their exact set-up was the costliest: milliseconds).
@@ -91,6 +115,9 @@ TEST(ProductTables, CommonTypesAreGenerated) {
   // tetrahedra: a type's set-up then builds no convolution.
   for (int id : {2, 3, 4, 5, 6, 7, 9, 10, 11, 12, 13, 14, 16, 17, 18, 19, 21, 23, 29, 36})
     EXPECT_FALSE(generated_product_tables(id)->gather_first[0].empty()) << find_element_type(id)->name;
+  // mu's derivative maps of the same types (lines have no mu space).
+  for (int id : {2, 3, 4, 5, 6, 7, 9, 10, 11, 12, 13, 14, 16, 17, 18, 19, 21, 23, 29, 36})
+    EXPECT_NE(generated_mu_tables(id), nullptr) << find_element_type(id)->name;
   EXPECT_EQ(generated_product_tables(93), nullptr);  // hexahedron of order 4: exact path
 }
 
