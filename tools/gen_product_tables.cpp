@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     const quadval::JacobianProduct product(*t, quadval::bezier_basis(t->family, t->order),
                                            quadval::TableSource::exact);
     const quadval::ProductTables tables = product.tables();
-    const std::string p = "t" + std::to_string(id);
+    const std::string p = std::string("t").append(std::to_string(id));  // not "t" + ...: a false -Wrestrict of GCC 12
     std::string matrix[2][3], deriv[3];
     for (int m = 0; m < 2; ++m)
       for (int c = 0; c < 3; ++c)
