@@ -36,6 +36,7 @@
 #include "analysis/product_tables.hpp"
 #include "analysis/pyramid_space.hpp"
 #include "bezier/bezier_exact.hpp"
+#include "bezier/multi_index_table.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
@@ -370,20 +371,12 @@ JacobianProduct::Product JacobianProduct::make_product(const Space& a, const Spa
     const auto ia = simplex_multi_indices(d, a.degree[hs]), ib = simplex_multi_indices(d, b.degree[hs]),
                ic = simplex_multi_indices(d, c.degree[hs]);
     std::vector<int> terms(ic.size(), 0);
-    // Where each multi-index of c sits, by its components 1-3 (component 0 follows from
-    // the degree): a table lookup, not a search (the search was most of a type's set-up).
-    const auto nc = static_cast<std::size_t>(c.degree[hs] + 1);
-    std::vector<int> where(nc * nc * nc, -1);
-    const auto key = [nc](const MultiIndex& m) {
-      return (static_cast<std::size_t>(m[1]) * nc + static_cast<std::size_t>(m[2])) * nc + static_cast<std::size_t>(m[3]);
-    };
-    for (std::size_t z = 0; z < ic.size(); ++z) where[key(ic[z])] = static_cast<int>(z);
+    const MultiIndexTable where(ic, c.degree[hs]);
     for (std::size_t x = 0; x < ia.size(); ++x)
       for (std::size_t y = 0; y < ib.size(); ++y) {
         MultiIndex s;
         for (std::size_t k = 0; k < 4; ++k) s[k] = ia[x][k] + ib[y][k];
-        const std::size_t at = key(s);
-        const int z = at < where.size() ? where[at] : -1;
+        const int z = where(s);
         QV_ASSERT(z >= 0 && ic[static_cast<std::size_t>(z)] == s, "multi-index outside the product space");
         p.pairs[hs].push_back({static_cast<int>(x), static_cast<int>(y), z});
         ++terms[static_cast<std::size_t>(z)];

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <tuple>
 
+#include "bezier/multi_index_table.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -41,15 +42,9 @@ BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
       if ((g / stride_[f]) % sizes[f] == 0) bases_[f].push_back(g);
     const int d = factors_[f].dim;
     const int n = factors_[f].degree;
-    // Local index of a multi-index by its components 1-3 (component 0 follows from the
-    // degree): a table lookup, not a search (a std::map here was most of the first
-    // subdivision's cost: 20 us of a 230 us check of tri_h0.4_o4).
-    const auto base = static_cast<std::size_t>(n + 1);
-    const auto key = [base](const std::array<int, 4>& m) {
-      return (static_cast<std::size_t>(m[1]) * base + static_cast<std::size_t>(m[2])) * base + static_cast<std::size_t>(m[3]);
-    };
-    std::vector<int> local_of(base * base * base, -1);
-    for (int i = 0; i < sizes[f]; ++i) local_of[key(alphas[f][static_cast<std::size_t>(i)])] = i;
+    // (A std::map here was most of the first subdivision's cost: 20 us of a 230 us check
+    // of tri_h0.4_o4.)
+    const MultiIndexTable local_of(alphas[f], n);
     for (int a = 0; a <= d; ++a)
       for (int b = 0; b <= d; ++b) {
         if (a == b) continue;
@@ -63,7 +58,7 @@ BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
           for (int i = 0; i <= m; ++i) {
             beta[static_cast<std::size_t>(a)] = m - i;
             beta[static_cast<std::size_t>(b)] = i;
-            el.index.push_back(local_of[key(beta)]);
+            el.index.push_back(local_of(beta));
           }
           el.first.push_back(static_cast<int>(el.index.size()));
         }

@@ -28,6 +28,7 @@
 #include <numeric>
 #include <tuple>
 
+#include "bezier/multi_index_table.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
 
@@ -177,14 +178,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
     const auto& fi = f_index[fac];
     const auto& gi = g_index[fac];
     const auto& hi = h_index_of[fac];
-    // Where each multi-index of h sits, by its components 1-3 (component 0 follows from
-    // the degree): a table lookup.
-    const auto base = static_cast<std::size_t>(nu + mu + 1);
-    const auto key = [base](const MultiIndex& m) {
-      return (static_cast<std::size_t>(m[1]) * base + static_cast<std::size_t>(m[2])) * base + static_cast<std::size_t>(m[3]);
-    };
-    std::vector<int> h_index(base * base * base, -1);
-    for (std::size_t k = 0; k < hi.size(); ++k) h_index[key(hi[k])] = static_cast<int>(k);
+    const MultiIndexTable h_index(hi, nu + mu);
     // The multinomials of every multi-index, once (not per pair).
     const auto multinomials = [d](const std::vector<MultiIndex>& list) {
       std::vector<U128> out;
@@ -198,7 +192,7 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
       for (std::size_t j = 0; j < gi.size(); ++j) {
         MultiIndex k{};
         for (std::size_t a = 0; a < 4; ++a) k[a] = fi[i][a] + gi[j][a];
-        const int kk = h_index[key(k)];
+        const int kk = h_index(k);
         QV_ASSERT(kk >= 0 && hi[static_cast<std::size_t>(kk)] == k, "multi-index outside the product space");
         U128 num;
         const bool fits = !__builtin_mul_overflow(f_alpha[i], g_alpha[j], &num);
@@ -296,13 +290,13 @@ void BernsteinProduct::build_grids() const {
       int rest = i, c = 0;
       std::array<int, 3> pos{0, 0, 0};
       Fraction alpha;
-      std::vector<const MultiIndex*> parts;
+      std::array<const MultiIndex*, 3> parts{};
       for (std::size_t f = 0; f < deg.size(); ++f) {
         const auto n = static_cast<int>(idx[f].size());
         const MultiIndex& a = idx[f][static_cast<std::size_t>(rest % n)];
         rest /= n;
         alpha = times(alpha, ratio(multinomial128(a, deg[f].dim), 1));
-        parts.push_back(&a);
+        parts[f] = &a;
         for (int k = 1; k <= deg[f].dim; ++k) pos[static_cast<std::size_t>(c++)] = a[static_cast<std::size_t>(k)];
       }
       const auto exact_alpha = [&] {
