@@ -8,6 +8,11 @@
 #include <memory>
 #include <mutex>
 #include <tuple>
+#include <utility>
+
+#if defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "bezier/multi_index_table.hpp"
 #include "quadval/error.hpp"
@@ -136,6 +141,64 @@ void casteljau_lanes(const double* src, const std::size_t* offset, std::size_t l
   }
 }
 
+#if defined(__AVX512F__)
+// The de Casteljau triangle of up to 8 parallel lines whose length m + 1 is a constant, so
+// that the whole triangle stays in registers: lane j holds the line whose coefficient i
+// sits at at[i] + lane_offset[j] (kContiguous: at[i] + j, one vector load or store),
+// lanes outside `mask` are zero and never stored. The same averages, in the same order,
+// as casteljau_lanes (bit-identical).
+constexpr int kMaxRegisterLine = 16;
+
+// Lane j at j * step from lane 0.
+struct LaneOffsets {
+  explicit LaneOffsets(std::size_t step) {
+    const auto s = static_cast<long long>(step);
+    v = _mm512_set_epi64(7 * s, 6 * s, 5 * s, 4 * s, 3 * s, 2 * s, s, 0);
+  }
+  __m512i v;
+};
+
+template <int M, bool kContiguous>
+void casteljau_registers(const double* src, const std::size_t* at, const LaneOffsets& lanes, __mmask8 mask,
+                         double* keep_a, double* keep_b) {
+  const __m512i lane_offset = lanes.v;
+  const auto load = [&](std::size_t off) {
+    if constexpr (kContiguous) return _mm512_maskz_loadu_pd(mask, src + off);
+    return _mm512_mask_i64gather_pd(_mm512_setzero_pd(), mask,
+                                    _mm512_add_epi64(lane_offset, _mm512_set1_epi64(static_cast<long long>(off))), src, 8);
+  };
+  const auto store = [&](double* out, std::size_t off, __m512d x) {
+    if constexpr (kContiguous)
+      _mm512_mask_storeu_pd(out + off, mask, x);
+    else
+      _mm512_mask_i64scatter_pd(out, mask, _mm512_add_epi64(lane_offset, _mm512_set1_epi64(static_cast<long long>(off))),
+                                x, 8);
+  };
+  const __m512d half = _mm512_set1_pd(0.5);
+  __m512d w[M + 1];
+#pragma GCC unroll 17
+  for (int i = 0; i <= M; ++i) w[i] = load(at[i]);
+  store(keep_a, at[0], w[0]);
+  store(keep_b, at[M], w[M]);
+#pragma GCC unroll 16
+  for (int r = 1; r <= M; ++r) {
+#pragma GCC unroll 16
+    for (int i = 0; i + r <= M; ++i) w[i] = _mm512_mul_pd(_mm512_add_pd(w[i], w[i + 1]), half);
+    store(keep_a, at[r], w[0]);
+    store(keep_b, at[M - r], w[M - r]);
+  }
+}
+
+using RegisterKernel = void (*)(const double*, const std::size_t*, const LaneOffsets&, __mmask8, double*, double*);
+template <bool kContiguous, int... M>
+constexpr std::array<RegisterKernel, sizeof...(M)> register_kernels(std::integer_sequence<int, M...>) {
+  return {&casteljau_registers<M, kContiguous>...};
+}
+constexpr std::array<std::array<RegisterKernel, kMaxRegisterLine + 1>, 2> kRegisterKernels = {
+    register_kernels<false>(std::make_integer_sequence<int, kMaxRegisterLine + 1>()),
+    register_kernels<true>(std::make_integer_sequence<int, kMaxRegisterLine + 1>())};
+#endif
+
 }  // namespace
 
 void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t f, int a, int b, double* keep_a,
@@ -156,6 +219,9 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
   const std::size_t run = side_by_side ? static_cast<std::size_t>(stride) : bases.size();
   const std::size_t lane = side_by_side ? 1 : static_cast<std::size_t>(stride_[1]);
   if (run >= kRun / 2) {
+#if defined(__AVX512F__)
+    const LaneOffsets strided_lanes(lane);
+#endif
     alignas(64) double w[kMaxLine][kRun];
     std::array<std::size_t, kMaxLine> offset;
     for (std::size_t v = 0; v < count; ++v) {
@@ -172,6 +238,13 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
             for (int i = 0; i <= m; ++i)
               offset[static_cast<std::size_t>(i)] = first + static_cast<std::size_t>(stride * idx[i]);
             const std::size_t width = std::min(kRun, run - j0);
+#if defined(__AVX512F__)
+            if (m <= kMaxRegisterLine) {
+              kRegisterKernels[side_by_side ? 1 : 0][static_cast<std::size_t>(m)](
+                  src, offset.data(), strided_lanes, static_cast<__mmask8>((1u << width) - 1), ka, kb);
+              continue;
+            }
+#endif
             if (side_by_side && width == kRun)
               casteljau_lanes<kRun, true>(src, offset.data(), lane, m, width, ka, kb, w);
             else if (side_by_side)
@@ -187,11 +260,18 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
   }
   // Up to kGroup vectors at once, lane v holding vector v: the same averages per
   // coefficient as one vector alone (bit-identical), the index work shared and the
-  // averages vectorised across the vectors.
-  constexpr std::size_t kGroup = 16;
-  std::array<double, kMaxLine * kGroup> w;  // lanes v < n of rows 0..m are written before read
+  // averages vectorised across the vectors, over all kGroup lanes (no remainder loop for
+  // the usual 3 to 8 vectors; lanes past the last vector are zeros, never stored).
+  constexpr std::size_t kGroup = 8;
+  alignas(64) std::array<double, kMaxLine * kGroup> w;
+#if defined(__AVX512F__)
+  const LaneOffsets vector_lanes(size);
+#endif
   for (std::size_t g0 = 0; g0 < count; g0 += kGroup) {
     const std::size_t n = std::min(kGroup, count - g0);
+#if defined(__AVX512F__)
+    const auto mask = static_cast<__mmask8>((1u << n) - 1);
+#endif
     const double* src = in + g0 * size;
     double* ka = keep_a + g0 * size;
     double* kb = keep_b + g0 * size;
@@ -201,8 +281,17 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
         const int m = el.first[l + 1] - el.first[l] - 1;
         QV_ASSERT(m < static_cast<int>(kMaxLine), "line of degree " << m);
         const auto at = [&](int i) { return static_cast<std::size_t>(base + stride * idx[i]); };
+#if defined(__AVX512F__)
+        if (m <= kMaxRegisterLine) {
+          std::array<std::size_t, kMaxRegisterLine + 1> offset;
+          for (int i = 0; i <= m; ++i) offset[static_cast<std::size_t>(i)] = at(i);
+          kRegisterKernels[0][static_cast<std::size_t>(m)](src, offset.data(), vector_lanes, mask, ka, kb);
+          continue;
+        }
+#endif
         for (int i = 0; i <= m; ++i)
-          for (std::size_t v = 0; v < n; ++v) w[static_cast<std::size_t>(i) * kGroup + v] = src[v * size + at(i)];
+          for (std::size_t v = 0; v < kGroup; ++v)
+            w[static_cast<std::size_t>(i) * kGroup + v] = v < n ? src[v * size + at(i)] : 0.0;
         // Level r of the de Casteljau triangle: w[0] is the keep-a child's coefficient with
         // r midpoints, w[m - r] the keep-b child's with m - r copies of b.
         for (std::size_t v = 0; v < n; ++v) {
@@ -214,7 +303,7 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
             double* lo = w.data() + static_cast<std::size_t>(j) * kGroup;
             const double* hi = lo + kGroup;
 #pragma omp simd
-            for (std::size_t v = 0; v < n; ++v) lo[v] = (lo[v] + hi[v]) * 0.5;
+            for (std::size_t v = 0; v < kGroup; ++v) lo[v] = (lo[v] + hi[v]) * 0.5;
           }
           for (std::size_t v = 0; v < n; ++v) {
             ka[v * size + at(r)] = w[v];

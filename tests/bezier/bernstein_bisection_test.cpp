@@ -292,6 +292,35 @@ TEST_P(BisectionTest, HalvingLevelsTimesIsOneSplit) {
   EXPECT_LT(space.halving_rounding_relative(), largest * 0x1p-53 * 1.01 + 1e-300);
 }
 
+TEST_P(BisectionTest, VectorsAtOnceEqualOneAtATime) {
+  // halve() of 11 vectors at once (lanes of 8 vectors, then 3) gives each vector's halves
+  // bit for bit as halving it alone, through two generations of states.
+  const BernsteinBisection space(GetParam());
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto size = static_cast<std::size_t>(space.size());
+  constexpr std::size_t kCount = 11;
+  std::vector<double> parent(kCount * size);
+  for (double& v : parent) v = u(rng);
+  BisectionState state = space.root_state();
+  for (int gen = 0; gen < space.levels() + 1; ++gen) {
+    std::vector<double> together(2 * kCount * size);
+    BisectionState st[2];
+    space.halve(parent.data(), kCount, state, together.data(), st);
+    for (std::size_t v = 0; v < kCount; ++v) {
+      std::vector<double> alone(2 * size);
+      BisectionState st1[2];
+      space.halve(parent.data() + v * size, 1, state, alone.data(), st1);
+      for (std::size_t q = 0; q < 2; ++q)
+        for (std::size_t i = 0; i < size; ++i)
+          ASSERT_EQ(together[(q * kCount + v) * size + i], alone[q * size + i])
+              << "generation " << gen << " vector " << v << " child " << q << " coefficient " << i;
+    }
+    parent.assign(together.begin() + static_cast<std::ptrdiff_t>(kCount * size), together.end());
+    state = st[1];
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Spaces, BisectionTest,
                          testing::Values(std::vector<FactorDegree>{{1, 7}}, std::vector<FactorDegree>{{2, 6}},
                                          std::vector<FactorDegree>{{3, 5}}, std::vector<FactorDegree>{{1, 3}, {1, 4}},
@@ -301,7 +330,11 @@ INSTANTIATE_TEST_SUITE_P(Spaces, BisectionTest,
                                          // paths): the spaces of N and D of quadratic hexahedra
                                          // and prisms.
                                          std::vector<FactorDegree>{{1, 10}, {1, 10}, {1, 10}},
-                                         std::vector<FactorDegree>{{2, 6}, {1, 9}}));
+                                         std::vector<FactorDegree>{{2, 6}, {1, 9}},
+                                         // Lines longer than the register kernels' 17
+                                         // coefficients (the general loop).
+                                         std::vector<FactorDegree>{{1, 20}}, std::vector<FactorDegree>{{2, 18}},
+                                         std::vector<FactorDegree>{{1, 3}, {1, 19}}));
 
 TEST(Bisection, DiametersHalveEveryDimLevels) {
   // Maubach's refinement of the reference tetrahedron (diameter sqrt 2): d = 3 bisections
