@@ -336,36 +336,100 @@ void BernsteinProduct::build_grids() const {
   f_grid_ = make_grid(f_degrees_, false);
   g_grid_ = make_grid(g_degrees_, false);
   h_grid_ = make_grid(h_degrees_, true);
+
+  // The outer operand's rows (its coefficients in cell order, cut where a cell is skipped
+  // or a row is full) and the inner operand's runs, spaced kRowBlock zeros apart.
+  outer_is_g_ = f_size_ > g_size_;
+  const Grid& outer = outer_is_g_ ? g_grid_ : f_grid_;
+  const Grid& inner = outer_is_g_ ? f_grid_ : g_grid_;
+  outer_order_.resize(outer.offset.size());
+  std::iota(outer_order_.begin(), outer_order_.end(), 0);
+  std::sort(outer_order_.begin(), outer_order_.end(),
+            [&](int a, int b) { return outer.offset[static_cast<std::size_t>(a)] < outer.offset[static_cast<std::size_t>(b)]; });
+  int row_end = 0;  // the cell just past the rows' last one
+  for (std::size_t p = 0; p < outer_order_.size(); ++p) {
+    const int cell = outer.offset[static_cast<std::size_t>(outer_order_[p])];
+    Row* last = outer_rows_.empty() ? nullptr : &outer_rows_.back();
+    if (last != nullptr && last->length < kRowBlock && cell == last->offset + last->length)
+      ++last->length;
+    else
+      outer_rows_.push_back({static_cast<int>(p), 1, cell});
+    row_end = std::max(row_end, cell + 1);
+  }
+  int guarded = kRowBlock, run_end = 0;
+  for (const auto& [start, length] : inner.runs) {
+    inner_runs_.push_back({start, length, guarded});
+    guarded += length + kRowBlock;
+    run_end = std::max(run_end, start + length);
+  }
+  guarded_size_ = guarded;
+  inner_guarded_.resize(inner.offset.size());
+  for (std::size_t j = 0; j < inner.offset.size(); ++j) {
+    const int cell = inner.offset[j];
+    const auto run = std::find_if(inner_runs_.begin(), inner_runs_.end(),
+                                  [&](const Run& r) { return cell >= r.start && cell < r.start + r.length; });
+    QV_ASSERT(run != inner_runs_.end(), "cell " << cell << " in no run");
+    inner_guarded_[j] = run->guarded + (cell - run->start);
+  }
+  // A row of length R against a run writes R - 1 cells past the run's end (zeros there).
+  acc_cells_ = std::max(h_cells_, row_end + kRowBlock - 1 + run_end);
 }
+
+namespace {
+
+// d[x] += sum_{k < R} a[k] s[x - k] for x in [0, n + R - 1): one row of R outer
+// coefficients at consecutive cells against a run of n inner ones, with R - 1 zeros before
+// and after it in s. Each cell of d is loaded and stored once per row instead of once per
+// coefficient. Every term a[k] s[x - k] is one product of the scaled form, summed with the
+// others of its cell in another order: the same error bound (top of this file).
+template <int R>
+void convolve_row(const double* a, const double* __restrict s, int n, double* __restrict d) {
+  for (int x = 0; x < n + R - 1; ++x) {
+    double t = a[0] * s[x];
+#pragma GCC unroll 8
+    for (int k = 1; k < R; ++k) t += a[k] * s[x - k];
+    d[x] += t;
+  }
+}
+
+}  // namespace
 
 void BernsteinProduct::accumulate_grid(const double* f, const double* g, double scale,
                                        double* acc) const {
-  // The operand with more coefficients is laid out (scaled, zero-padded) in h's strides
-  // and added, times each scaled coefficient of the other, at that coefficient's cell:
-  // one contiguous loop per run of its grid (the cells between its rows inside a run are
-  // zeros of the padding: a * 0 + x = x exactly). Every cell of a run lies inside h's
-  // grid (i_c + j_c <= h_c - 1 per coordinate).
-  thread_local std::vector<double> pad;
-  const bool swap = f_size_ > g_size_;
-  const Grid& outer = swap ? g_grid_ : f_grid_;
-  const Grid& inner = swap ? f_grid_ : g_grid_;
-  const double* ov = swap ? g : f;
-  const double* iv = swap ? f : g;
-  const int n_outer = swap ? g_size_ : f_size_;
-  const int n_inner = swap ? f_size_ : g_size_;
-  const auto& last = inner.runs.back();
-  pad.assign(static_cast<std::size_t>(last[0] + last[1]), 0.0);
-  for (int j = 0; j < n_inner; ++j)
-    pad[static_cast<std::size_t>(inner.offset[static_cast<std::size_t>(j)])] = inner.scale[static_cast<std::size_t>(j)] * iv[j];
-  const double* __restrict src = pad.data();
-  for (int i = 0; i < n_outer; ++i) {
-    const double a = (scale * outer.scale[static_cast<std::size_t>(i)]) * ov[i];
-    if (a == 0) continue;
-    double* __restrict dst = acc + outer.offset[static_cast<std::size_t>(i)];
-    for (const auto& [start, len] : inner.runs) {
-      double* __restrict d = dst + start;
-      const double* __restrict s = src + start;
-      for (int t = 0; t < len; ++t) d[t] += a * s[t];
+  // The inner operand, scaled, is copied run by run with kRowBlock zeros between runs;
+  // each row of the outer operand's scaled coefficients (times scale) is then convolved
+  // with every run, into acc at the row's cell.
+  thread_local std::vector<double> guarded;
+  const Grid& outer = outer_is_g_ ? g_grid_ : f_grid_;
+  const Grid& inner = outer_is_g_ ? f_grid_ : g_grid_;
+  const double* ov = outer_is_g_ ? g : f;
+  const double* iv = outer_is_g_ ? f : g;
+  guarded.assign(static_cast<std::size_t>(guarded_size_), 0.0);
+  for (std::size_t j = 0; j < inner_guarded_.size(); ++j)
+    guarded[static_cast<std::size_t>(inner_guarded_[j])] = inner.scale[j] * iv[j];
+  for (const Row& row : outer_rows_) {
+    std::array<double, kRowBlock> a;
+    bool zero = true;
+    for (int k = 0; k < row.length; ++k) {
+      const auto i = static_cast<std::size_t>(outer_order_[static_cast<std::size_t>(row.first + k)]);
+      a[static_cast<std::size_t>(k)] = (scale * outer.scale[i]) * ov[i];
+      zero = zero && a[static_cast<std::size_t>(k)] == 0;
+    }
+    if (zero) continue;
+    double* dst = acc + row.offset;
+    for (const Run& run : inner_runs_) {
+      const double* s = guarded.data() + run.guarded;
+      double* d = dst + run.start;
+      switch (row.length) {
+        case 1: convolve_row<1>(a.data(), s, run.length, d); break;
+        case 2: convolve_row<2>(a.data(), s, run.length, d); break;
+        case 3: convolve_row<3>(a.data(), s, run.length, d); break;
+        case 4: convolve_row<4>(a.data(), s, run.length, d); break;
+        case 5: convolve_row<5>(a.data(), s, run.length, d); break;
+        case 6: convolve_row<6>(a.data(), s, run.length, d); break;
+        case 7: convolve_row<7>(a.data(), s, run.length, d); break;
+        default: convolve_row<8>(a.data(), s, run.length, d); break;
+      }
     }
   }
 }
@@ -421,7 +485,7 @@ void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) 
   }
   std::call_once(grids_once_, [this] { build_grids(); });
   thread_local std::vector<double> acc;
-  acc.assign(static_cast<std::size_t>(h_cells_), 0.0);
+  acc.assign(static_cast<std::size_t>(acc_cells_), 0.0);
   for (const Term& t : terms) accumulate_grid(t.f, t.g, t.scale, acc.data());
   for (int k = 0; k < h_size_; ++k)
     h[k] += acc[static_cast<std::size_t>(h_grid_.offset[static_cast<std::size_t>(k)])] * h_grid_.scale[static_cast<std::size_t>(k)];

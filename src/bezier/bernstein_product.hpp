@@ -104,11 +104,31 @@ class BernsteinProduct {
     std::vector<double> scale;   // alpha (f, g) or 1 / alpha (h) per coefficient, rounded
     std::vector<std::array<int, 2>> runs;  // (offset, length): contiguous runs covering it
   };
+  // The convolution runs over rows of the smaller operand ("outer": up to kRowBlock of its
+  // coefficients at consecutive cells, together), each row against every run of the
+  // larger one ("inner"), whose runs are copied apart with kRowBlock zeros between them.
+  static constexpr int kRowBlock = 8;
+  struct Row {
+    int first;   // position in outer_order_
+    int length;  // 1..kRowBlock coefficients at cells offset, offset + 1, ...
+    int offset;
+  };
+  struct Run {
+    int start, length;  // cells of h's grid
+    int guarded;        // where it starts in the guarded copy
+  };
   // Built on the grid kernel's first use (thread-safe): a small product never needs them
   // (their set-up was a third of a small product's).
   mutable std::once_flag grids_once_;
   mutable Grid f_grid_, g_grid_, h_grid_;
-  mutable int h_cells_ = 1;  // cells of h's grid
+  mutable int h_cells_ = 1;    // cells of h's grid
+  mutable int acc_cells_ = 1;  // cells the rows write: h's grid and the zeros past a row's end
+  mutable bool outer_is_g_ = false;
+  mutable std::vector<int> outer_order_;  // outer coefficients by cell
+  mutable std::vector<Row> outer_rows_;
+  mutable std::vector<Run> inner_runs_;
+  mutable std::vector<int> inner_guarded_;  // per inner coefficient: its place in the guarded copy
+  mutable int guarded_size_ = 0;
   void build_grids() const;
   bool entries_kernel_ = false;  // the weighted-entry loop (small products)
   // acc (h's grid) += scale * (scaled f) conv (scaled g).
