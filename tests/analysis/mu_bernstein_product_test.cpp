@@ -169,6 +169,10 @@ TEST(MuBernsteinProduct, SumsOfProductsMatchExactCoefficients) {
       {{{2, 4}, {1, 3}}, {{2, 2}, {1, 1}}},
       {{{2, 6}}, {{2, 6}}},
       {{{1, 6}, {1, 6}}, {{1, 3}, {1, 3}}},
+      // Rows of the smaller operand of every length up to 8 (triangle of degree 7), and
+      // longer ones cut into 8 + 2 (line factor of degree 9).
+      {{{2, 7}}, {{2, 8}}},
+      {{{1, 9}, {1, 2}}, {{1, 10}, {1, 3}}},
   };
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);
