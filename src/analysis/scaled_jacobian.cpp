@@ -19,6 +19,7 @@
 #include "analysis/lane_vector.hpp"
 #include "analysis/linear_jacobian.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/ratio_scan.hpp"
 #include "analysis/scaled_jacobian_quotient.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/straight_sided.hpp"
@@ -32,7 +33,6 @@ namespace {
 
 constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr int kW = 8;  // lanes of the vectorised folds
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
 // Splits of J and the columns before the products (the quotient stage, which refines only
@@ -83,26 +83,14 @@ class Bounder {
     bool positive = true;
     for (std::size_t i = 0; i < size_ && positive && !valid_; ++i) positive = down(j[i] - err[0]) > 0;
     if (positive) {
-      // r = min_k min_i (N_i - e) / (D_k,i + e_k): one pass per frame without directed
-      // roundings, as in max_ratio; only a positive r is used, and then every N_i - e > 0.
+      // r = min_k min_i (N_i - e) / (D_k,i + e_k): per frame without directed roundings
+      // (ratio_scan.hpp), as in max_ratio; only a positive r is used, and then every N_i - e > 0.
       double r = kInf;
       for (std::size_t k = 0; k < frames_; ++k) {
-        const double* d = v + (2 + k) * size_;
         const double ed = err[2 + k];
-        Lanes<kW> least_d8 = broadcast_lanes<kW>(kInf), rk8 = least_d8;
-        std::size_t i = 0;
-        for (; i + kW <= size_; i += kW) {
-          const Lanes<kW> di = load_lanes<kW>(d + i);
-          least_d8 = vmin(least_d8, di - ed);
-          rk8 = vmin(rk8, (load_lanes<kW>(n + i) - err[1]) / (di + ed));
-        }
-        double least_d = fold_min(least_d8, kInf), rk = fold_min(rk8, kInf);
-        for (; i < size_; ++i) {
-          least_d = std::min(least_d, d[i] - ed);
-          rk = std::min(rk, (n[i] - err[1]) / (d[i] + ed));
-        }
-        if (!(least_d > 0)) return 0;  // relaxation fails here; J > 0 gives sj > 0
-        r = std::min(r, rk);
+        const RatioScan scan = scan_ratios<true>(n, -err[1], v + (2 + k) * size_, ed, -ed, size_);
+        if (!(scan.least_den > 0)) return 0;  // relaxation fails here; J > 0 gives sj > 0
+        r = std::min(r, scan.extreme);
       }
       r = r > 0 ? down(down(r * (1 - 4 * kUnit)) - std::numeric_limits<double>::denorm_min()) : 0;
       return down(space_.s_lo() * down(std::sqrt(std::max(0.0, r))));
@@ -195,26 +183,15 @@ class Bounder {
   double least(const double* x) const { return least_value(x, size_); }
 
   // An upper bound of max_i (num_i + num_err) / (den_i - den_err), at least 0, or 1 (no
-  // bound) unless every den_i - den_err is positive. One pass without directed roundings
-  // (vectorised): a difference of doubles keeps its sign exactly, and each of the sum, the
+  // bound) unless every den_i - den_err is positive. Without directed roundings
+  // (ratio_scan.hpp): a difference of doubles keeps its sign exactly, and each of the sum, the
   // difference and the quotient rounds once (relative u each; an underflowing quotient
   // loses at most denorm_min), so (1 + 4u) times the computed maximum, rounded up, plus
   // denorm_min covers the exact one.
   double max_ratio(const double* num, double num_err, const double* den, double den_err) const {
-    Lanes<kW> least8 = broadcast_lanes<kW>(kInf), r8 = broadcast_lanes<kW>(0);
-    std::size_t i = 0;
-    for (; i + kW <= size_; i += kW) {
-      const Lanes<kW> d = load_lanes<kW>(den + i) - den_err;
-      least8 = vmin(least8, d);
-      r8 = vmax(r8, (load_lanes<kW>(num + i) + num_err) / d);
-    }
-    double least = fold_min(least8, kInf), r = fold_max(r8, 0.0);
-    for (; i < size_; ++i) {
-      const double d = den[i] - den_err;
-      least = std::min(least, d);
-      r = std::max(r, (num[i] + num_err) / d);
-    }
-    if (!(least > 0)) return 1;
+    const RatioScan scan = scan_ratios<false>(num, num_err, den, -den_err, -den_err, size_);
+    if (!(scan.least_den > 0)) return 1;
+    const double r = 0 < scan.extreme ? scan.extreme : 0.0;
     return up(up(r * (1 + 4 * kUnit)) + std::numeric_limits<double>::denorm_min());
   }
 

@@ -1,5 +1,6 @@
 list(APPEND QUADVAL_TEST_SOURCES
   analysis/mu_bounds_test.cpp
+  analysis/ratio_scan_test.cpp
   analysis/mu_sampling_test.cpp
   analysis/mu_filter_test.cpp
   analysis/mu_bernstein_product_test.cpp
