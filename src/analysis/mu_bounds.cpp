@@ -337,7 +337,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       std::copy(scratch.children.begin() + static_cast<std::ptrdiff_t>(q * block),
                 scratch.children.begin() + static_cast<std::ptrdiff_t>((q + 1) * block),
                 pool.begin() + static_cast<std::ptrdiff_t>(child));
-      const double corner = corner_ratio_upper(space, pool.data() + child, child_err, &scratch.corners);
+      const double corner = corner_ratio_upper(space, pool.data() + child, child_err, &scratch.corners, r_upper);
       r_upper = std::min(r_upper, corner);
       const double lo = subdomain_lower(pool.data() + child, child_err, top.lower, std::min(corner, r_upper));
       heap.push({lo, child_err, slot, halving ? states[q] : top.state});

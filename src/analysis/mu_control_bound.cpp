@@ -127,8 +127,9 @@ bool positive_definite3(const double* a) {
   return det > g * mag * (1 + g);
 }
 
-// True when lambda_min >= r lambda_max is certified for every exact symmetric M' with
-// |M'_ij - m_ij| <= err: no eigenvalue needed. By Laguerre and Samuelson, every
+}  // namespace
+
+// No eigenvalue needed. By Laguerre and Samuelson, every
 // eigenvalue of m lies within sqrt 2 sigma of their mean mu = tr m / 3, sigma^2 =
 // tr((m - mu I)^2) / 3 <= tr((m - c I)^2) / 3 for any c (here the computed mean), so
 // t = c + |mu - c| + sqrt(2/3 tr((m - c I)^2)) + 3 err >= lambda_max(M') (|E|_2 <= 3 err),
@@ -150,8 +151,6 @@ bool ratio_at_least3(const double* m, double err, double r) {
   const double s[6] = {next_down(m[0] - sa), next_down(m[1] - sa), next_down(m[2] - sa), m[3], m[4], m[5]};
   return positive_definite3(s);
 }
-
-}  // namespace
 
 bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi) {
   // Eigenvalues q + y of M: y^3 - 3 p^2 y - e3 = 0 with D = M - q I, p^2 = tr D^2 / 6,

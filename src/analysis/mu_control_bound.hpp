@@ -67,6 +67,12 @@ bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& 
 /// @pre 0 <= r < 1
 bool ratio_at_least2(const double* m, double err, double r);
 
+/// The same for a symmetric 3 x 3 matrix (entries m00, m11, m22, m01, m02, m12), with one
+/// square root (Laguerre-Samuelson bound of lambda_max, then Sylvester's criterion on
+/// M - r lambda_max I); fails when eigenvalues cluster at the top.
+/// @pre 0 <= r < 1
+bool ratio_at_least3(const double* m, double err, double r);
+
 /// Certified lower bound of min R over a subdomain (the concavity argument above): the
 /// least certified ratio over the control matrices. A matrix whose ratio is certified to
 /// be at least the least one so far without eigenvalues (Laguerre-Samuelson bound of

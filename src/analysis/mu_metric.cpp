@@ -488,16 +488,81 @@ void remember_corners(const MuSpace& space, const double* w, std::vector<std::ar
   for (const int k : space.w_basis().vertex_indices()) seen.push_back(corner_w(space, w, k));
 }
 
+namespace {
+
+// The metric W^T W of a corner's W (corner_w's layout) in control_ratio_lower's entry
+// order, and a bound on its distance to the exact metric when every entry of W is within
+// err: |W'^T W' - W^T W|_ij <= sum_c (|w_ci| + |w_cj| + err) err, plus gamma_4 of
+// sum_c |w_ci w_cj| for the computed sums (and 1e-12 relative for the bound's own rounding).
+struct CornerMetric {
+  std::array<double, 6> m{};
+  double err = 0;
+};
+CornerMetric corner_metric(const std::array<double, 9>& w, int dim, double err) {
+  static constexpr int kPairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+  static constexpr int kPairs2[3][2] = {{0, 0}, {1, 1}, {0, 1}};
+  CornerMetric out;
+  const int n = dim == 2 ? 3 : 6;
+  for (int e = 0; e < n; ++e) {
+    const int i = dim == 2 ? kPairs2[e][0] : kPairs[e][0];
+    const int j = dim == 2 ? kPairs2[e][1] : kPairs[e][1];
+    double sum = 0, mag = 0, prop = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double a = w[static_cast<std::size_t>(i * 3 + c)], b = w[static_cast<std::size_t>(j * 3 + c)];
+      sum += a * b;
+      mag += std::abs(a * b);
+      prop += (std::abs(a) + std::abs(b) + err) * err;
+    }
+    out.m[static_cast<std::size_t>(e)] = sum;
+    out.err = std::max(out.err, (prop + rounding_gamma(4) * mag) * (1 + 1e-12));
+  }
+  return out;
+}
+
+// A cheap estimate of R at a corner (not certified: it only orders the corners, so that
+// the least bound is usually found first): det M / (tr M / dim)^dim, 1 for isotropic M.
+double corner_estimate(const CornerMetric& cm, int dim) {
+  const auto& m = cm.m;
+  if (dim == 2) {
+    const double t = 0.5 * (m[0] + m[1]);
+    return (m[0] * m[1] - m[2] * m[2]) / (t * t);
+  }
+  const double t = (m[0] + m[1] + m[2]) / 3;
+  const double det = m[0] * (m[1] * m[2] - m[5] * m[5]) - m[3] * (m[3] * m[2] - m[5] * m[4]) +
+                     m[4] * (m[3] * m[5] - m[1] * m[4]);
+  return det / (t * t * t);
+}
+
+}  // namespace
+
 double corner_ratio_upper(const MuSpace& space, const double* w, double err,
-                          std::vector<std::array<double, 9>>* seen) {
-  double best = 1;
+                          std::vector<std::array<double, 9>>* seen, double below) {
+  const int dim = space.dim();
+  struct Corner {
+    int k;
+    double estimate;
+    CornerMetric metric;
+  };
+  thread_local std::vector<Corner> corners;
+  corners.clear();
   for (const int k : space.w_basis().vertex_indices()) {
+    const std::array<double, 9> key = corner_w(space, w, k);
     if (seen) {
-      const std::array<double, 9> key = corner_w(space, w, k);
       if (std::find(seen->begin(), seen->end(), key) != seen->end()) continue;
       seen->push_back(key);
     }
-    best = std::min(best, corner_ratio_upper_at(space, w, err, k));
+    const CornerMetric cm = corner_metric(key, dim, err);
+    const double estimate = corner_estimate(cm, dim);
+    corners.push_back({k, std::isnan(estimate) ? -1.0 : estimate, cm});
+  }
+  std::stable_sort(corners.begin(), corners.end(),
+                   [](const Corner& a, const Corner& b) { return a.estimate < b.estimate; });
+  double best = below;
+  for (const Corner& c : corners) {
+    if (best < 1 && (dim == 2 ? ratio_at_least2(c.metric.m.data(), c.metric.err, best)
+                              : ratio_at_least3(c.metric.m.data(), c.metric.err, best)))
+      continue;  // R >= best here: its bound would not lower best
+    best = std::min(best, corner_ratio_upper_at(space, w, err, c.k));
   }
   return best;
 }

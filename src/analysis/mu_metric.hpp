@@ -98,8 +98,13 @@ class MuMetric {
 ///              and every corner evaluated is appended. Subdivision children share most
 ///              corners with their parent and their siblings (a hexahedron's 8 children:
 ///              64 corners, 27 points, 8 of them the parent's).
+/// @param below  the result is at most this (an upper bound known already); a corner
+///               whose R is certified to be at least the least bound so far
+///               (ratio_at_least2/3 of mu_control_bound.hpp, on its metric) is not bounded,
+///               as its bound could not lower the result: the same value as bounding every
+///               corner, with a fraction of the eigen solves.
 double corner_ratio_upper(const MuSpace& space, const double* w, double err,
-                          std::vector<std::array<double, 9>>* seen = nullptr);
+                          std::vector<std::array<double, 9>>* seen = nullptr, double below = 1);
 /// The same bound at one control point k of W (a corner: a value of R at a point of the
 /// subdomain, so an upper bound of its minimum on its own).
 /// @param eigenvectors  optional: approximate eigenvectors of the corner's metric (dim x dim,

@@ -18,6 +18,7 @@
 #include <random>
 
 #include "analysis/mu_control_bound.hpp"
+#include "analysis/mu_metric.hpp"
 #include "analysis/mu_space.hpp"
 #include "jacobian_test_util.hpp"
 #include "mu_test_util.hpp"
@@ -280,6 +281,40 @@ TEST(MuControlBound, ControlRatioAgainstExactKroneckerCriterion) {
     ++sets;
   }
   EXPECT_EQ(sets, 60);
+}
+
+// corner_ratio_upper skips the corners whose R is certified to be at least its least bound
+// so far: its value must equal, bit for bit, the least of the bounds at every corner
+// (corner_ratio_upper_at, no skipping) and `below`, on random corner values of W ranging
+// from nearly isotropic (most corners skipped) to strongly stretched.
+TEST(MuControlBound, CornerBoundEqualsTheLeastOverEveryCorner) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int skipping_cases = 0;
+  for (const ElementType& t : element_types()) {
+    if (t.family == ElementFamily::line || !mu_supported(t) || t.order > 2) continue;
+    SCOPED_TRACE(std::string(t.name));
+    const MuSpace& space = mu_space(t);
+    const auto ws = static_cast<std::size_t>(space.w_size());
+    std::vector<double> w(static_cast<std::size_t>(space.dim()) * 3 * ws);
+    for (int trial = 0; trial < 60; ++trial) {
+      const double noise = trial % 3 == 0 ? 1e-3 : trial % 3 == 1 ? 0.1 : 0.8;
+      for (int j = 0; j < space.dim(); ++j)
+        for (int c = 0; c < 3; ++c)
+          for (std::size_t k = 0; k < ws; ++k)
+            w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(c)) * ws + k] =
+                (j == c ? 1.0 : 0.0) + noise * u(rng);
+      const double err = trial % 2 == 0 ? 0.0 : 1e-9;
+      const double below = trial % 4 == 3 ? 0.5 : 1.0;
+      double want = below;
+      for (const int k : space.w_basis().vertex_indices())
+        want = std::min(want, corner_ratio_upper_at(space, w.data(), err, k));
+      const double got = corner_ratio_upper(space, w.data(), err, nullptr, below);
+      ASSERT_EQ(got, want) << "trial " << trial;
+      if (noise < 0.01) ++skipping_cases;
+    }
+  }
+  EXPECT_GT(skipping_cases, 100);
 }
 
 // mu_bounds with the given subdomain bound against dense sampling of W's singular values.
