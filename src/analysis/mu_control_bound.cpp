@@ -8,9 +8,12 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "quadval/bezier_basis.hpp"
 
@@ -152,6 +155,84 @@ bool ratio_at_least3(const double* m, double err, double r) {
   return positive_definite3(s);
 }
 
+namespace {
+
+// ratio_at_least3 and positive_definite3 on 8 matrices at once (lane l: entries m[i][l]),
+// every lane computed with the same operations, in the same order, as the scalar
+// functions (bit-identical decisions); true lanes set in the returned mask.
+using L8 = Lanes<8>;
+typedef std::int64_t I8 __attribute__((vector_size(64)));
+
+L8 next_up8(L8 x) {  // next_up (outward_rounding.hpp) lane by lane
+  constexpr std::int64_t kMagnitude = 0x7fffffffffffffff, kInfBits = 0x7ff0000000000000;
+  const I8 b = std::bit_cast<I8>(x);
+  const I8 mag = b & kMagnitude;
+  I8 r = b < 0 ? b - 1 : b + 1;
+  r = mag == 0 ? I8{} + 1 : r;
+  r = (mag > kInfBits) | (b == kInfBits) ? b : r;
+  return std::bit_cast<L8>(r);
+}
+L8 next_down8(L8 x) { return -next_up8(-x); }
+
+I8 positive_definite3_lanes(const L8* a) {
+  static const double g = rounding_gamma(8);
+  const L8 p01 = a[0] * a[1], s01 = a[3] * a[3];
+  const L8 c0 = a[1] * a[2] - a[5] * a[5];
+  const L8 c1 = a[3] * a[2] - a[5] * a[4];
+  const L8 c2 = a[3] * a[5] - a[1] * a[4];
+  const L8 det = a[0] * c0 - a[3] * c1 + a[4] * c2;
+  const L8 mag = vabs(a[0]) * (vabs(a[1] * a[2]) + a[5] * a[5]) + vabs(a[3]) * (vabs(a[3] * a[2]) + vabs(a[5] * a[4])) +
+                 vabs(a[4]) * (vabs(a[3] * a[5]) + vabs(a[1] * a[4]));
+  return (a[0] > 0) & (p01 - s01 > g * (vabs(p01) + s01) * (1 + g)) & (det > g * mag * (1 + g));
+}
+
+unsigned ratio_at_least3_lanes(const L8* m, double err, double r) {
+  constexpr double u = 0x1p-53;
+  const L8 c = (m[0] + m[1] + m[2]) / 3;
+  const L8 shift = 4 * u * (vabs(m[0]) + vabs(m[1]) + vabs(m[2]));
+  const L8 d0 = m[0] - c, d1 = m[1] - c, d2 = m[2] - c;
+  const L8 sq = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (m[3] * m[3] + m[4] * m[4] + m[5] * m[5]);
+  const I8 finite = vabs(sq) <= std::numeric_limits<double>::max();
+  L8 root = next_up8(sq * (2.0 / 3.0) * (1 + 16 * u));
+  for (int l = 0; l < 8; ++l) root[l] = std::sqrt(root[l]);  // vsqrtpd: exact rounding, as std::sqrt
+  const L8 spread = next_up8(root);
+  const double e3 = next_up(3 * err * (1 + 1e-15));
+  const L8 t = next_up8(next_up8(next_up8(c + shift) + spread) + e3);
+  const L8 sa = next_up8(next_up8(r * t) + e3);
+  const L8 a[6] = {next_down8(m[0] - sa), next_down8(m[1] - sa), next_down8(m[2] - sa), m[3], m[4], m[5]};
+  const I8 ok = finite & positive_definite3_lanes(a);
+  unsigned mask = 0;
+  for (int l = 0; l < 8; ++l) mask |= ok[l] != 0 ? 1u << l : 0u;
+  return mask;
+}
+
+}  // namespace
+
+namespace {
+
+// cos(acos(c) / 3) for c in [-1, 1], without trigonometric calls (acos and sincos were a
+// fifth of mu's time on linear hexahedra): the largest root x in [1/2, 1] of
+// 4 x^3 - 3 x = c, from a polynomial in s = sqrt((1 + c) / 2) (least squares on Chebyshev
+// points, within 2.3e-8 of cos(2/3 acos s) on [0, 1]) and two Newton steps. Within a few
+// ulps of the trigonometric form except close to c = -1, where both lose accuracy as
+// 1 / sqrt(1 + c) (the top two eigenvalues nearly equal); the caller polishes the
+// eigenvalues and certifies them whatever their accuracy.
+double trisected_cosine(double c) {
+  const double s = std::sqrt(0.5 * (1 + c));
+  double x = 0x1.2d945fe635cc5p-10;
+  for (const double a : {-0x1.945b176bae327p-8, 0x1.08c20eb3ca04dp-6, -0x1.f0a66ec75bf0ap-6, 0x1.b11a9b6a6b367p-5,
+                         -0x1.c6d5485f6740bp-4, 0x1.279a0e23f9291p-1, 0x1.000000c367160p-1})
+    x = x * s + a;
+  for (int step = 0; step < 2; ++step) {
+    const double slope = 12 * x * x - 3;
+    if (!(slope > 0)) break;
+    x -= ((4 * x * x - 3) * x - c) / slope;
+  }
+  return std::clamp(x, 0.5, 1.0);
+}
+
+}  // namespace
+
 bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& max_hi) {
   // Eigenvalues q + y of M: y^3 - 3 p^2 y - e3 = 0 with D = M - q I, p^2 = tr D^2 / 6,
   // e3 = det D; y = 2 p cos(theta + 2 pi k / 3), cos(3 theta) = e3 / (2 p^3).
@@ -166,8 +247,8 @@ bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& 
     const double p = std::sqrt(p2);
     const double e3 = d0 * (d1 * d2 - m[5] * m[5]) - m[3] * (m[3] * d2 - m[5] * m[4]) + m[4] * (m[3] * m[5] - d1 * m[4]);
     const double c = std::clamp(e3 / (2 * p2 * p), -1.0, 1.0);
-    const double theta = std::acos(c) / 3;
-    const double ct = std::cos(theta), st = std::sin(theta);  // one sincos
+    const double ct = trisected_cosine(c);
+    const double st = std::sqrt((1 - ct) * (1 + ct));
     y_max = 2 * p * ct;
     y_min = 2 * p * (-0.5 * ct - 0.8660254037844386 * st);  // cos(theta + 2 pi / 3)
     // One Newton step each on y^3 - 3 p^2 y - e3 (accuracy only, not soundness).
@@ -218,7 +299,24 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
   for (int i = 0; i < kEntries; ++i) e = std::max(e, err[i]);
   double r = 1;
   double m[kEntries];
+  // 3D: once a ratio is certified, the cheap test runs on 8 control matrices at once with
+  // the r of the block's start; a matrix it certifies is at least that r, so at least the
+  // current one, and is skipped as the scalar test would skip it (the test is monotone in
+  // r). Only the others go through the scalar loop below, in order.
+  unsigned certified = 0;  // bit l: matrix block_start + l certified
+  int block_start = 0, block_end = 0;
   for (int k = 0; k < size && r > 0; ++k) {
+    if constexpr (D == 3) {
+      if (r < 1 && k >= block_end && size - k >= 4) {
+        block_start = k;
+        block_end = std::min(k + 8, size);
+        Lanes<8> lanes[6];
+        for (int i = 0; i < 6; ++i)
+          for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
+        certified = ratio_at_least3_lanes(lanes, e, r);
+      }
+      if (k < block_end && ((certified >> (k - block_start)) & 1u) != 0) continue;
+    }
     for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
     // Most control matrices lie well above the least ratio found so far: certify that
     // cheaply and skip their eigenvalue enclosure (r stays a lower bound of their ratios).
