@@ -28,7 +28,8 @@ namespace {
 
 struct Subdomain {
   double lower;  // certified lower bound of min R on it
-  double err;    // |control values - exact| <= err
+  double err;    // |control values of W - exact| <= err
+  double m_err;  // the same for M's, when the pool holds them
   int slot;      // its control values in the pool
   BisectionState state;
   bool operator>(const Subdomain& o) const {
@@ -263,10 +264,23 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // bound alone, whatever mode was asked for.
   constexpr int kCertificateAfter = 24;
   const int mode = space.has_certificate() ? control_mode : 1;
-  const auto subdomain_lower = [&](const double* w, double err, double r_lo, double r_hi) {
+  // Halving (not tetrahedra) with the control bound: each subdomain's slot also holds M's
+  // control values, halved with W's (the same bisection sequence: M's space has W's
+  // factors at twice the degree), so that a child's control bound needs no product.
+  const bool halving = type.family != ElementFamily::tetrahedron;
+  const bool track_metric = halving && mode != 0;
+  const BernsteinBisection& bisection = bernstein_bisection(space.degrees(1));
+  const BernsteinBisection* m_bisection = track_metric ? &bernstein_bisection(space.degrees(2)) : nullptr;
+  const int vectors = space.dim() * 3;
+  const int m_vectors = metric_vectors(space.dim());
+  QV_ASSERT(!track_metric || m_bisection->size() == space.size(2), "M's space");
+  const auto w_block = block;
+  const auto slot_size = w_block + (track_metric ? static_cast<std::size_t>(m_vectors * space.size(2)) : 0);
+  const auto subdomain_lower = [&](const double* w, double err, double m_err, double r_lo, double r_hi) {
     double lo = r_lo;
     if (mode != 0) {
-      lo = std::max(lo, scratch.metric.control_lower_bound(space, w, err));
+      lo = std::max(lo, track_metric ? control_lower_bound_of_metric(space.dim(), w + w_block, m_err, space.size(2))
+                                     : scratch.metric.control_lower_bound(space, w, err));
       if (mode == 1 || out.subdivisions < kCertificateAfter || lo >= r_target() ||
           !(std::min(r_hi, 1.0) - lo > tol_r()))
         return lo;
@@ -280,16 +294,18 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // warped_prism 28 -> 22 ms, warped_pyramid_o2 74 -> 64 ms, the 2D meshes within noise;
   // but tets_h0.8_o2 42 -> 71 ms (Maubach's children of a tetrahedron close the
   // control-matrix gap more slowly: 185 subdivisions instead of 113).
-  const bool halving = type.family != ElementFamily::tetrahedron;
-  const BernsteinBisection& bisection = bernstein_bisection(space.degrees(1));
   const long levels = halving ? bisection.levels() : 1;
   const auto children = static_cast<std::size_t>(halving ? 2 : basis.num_children());
   long steps = 0;
   std::priority_queue<Subdomain, std::vector<Subdomain>, std::greater<>> heap;
-  heap.push({subdomain_lower(pool.data(), err0, 0, r_upper), err0, 0, bisection.root_state()});
+  double m_err0 = 0;
+  if (track_metric) {
+    pool.resize(slot_size);
+    m_err0 = scratch.metric.metric(space, pool.data(), err0, pool.data() + w_block);
+  }
+  heap.push({subdomain_lower(pool.data(), err0, m_err0, 0, r_upper), err0, m_err0, 0, bisection.root_state()});
   int next_slot = 1;
-  const int vectors = space.dim() * 3;
-  scratch.children.resize(children * block);
+  scratch.children.resize(children * slot_size);
   scratch.sub_scratch.resize(2 * static_cast<std::size_t>(basis.size()));
   while (true) {
     const Subdomain top = heap.top();
@@ -303,7 +319,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
     heap.pop();
     ++steps;
     out.subdivisions = static_cast<int>((steps + levels - 1) / levels);
-    const auto par = static_cast<std::size_t>(top.slot) * block;
+    const auto par = static_cast<std::size_t>(top.slot) * slot_size;
     const double wmax = largest_magnitude(pool.data() + par, block);
     // Averages (halving) and rows of exact nonnegative weights summing to 1 (midpoint
     // children) never exceed their inputs: the parent's error plus the step's rounding.
@@ -315,13 +331,25 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
     scratch.corners.clear();
     remember_corners(space, pool.data() + par, scratch.corners);
     BisectionState states[2];
+    double child_m_err = 0;
     if (halving) {
-      bisection.halve(pool.data() + par, static_cast<std::size_t>(vectors), top.state, scratch.children.data(), states);
+      double* first = scratch.children.data();
+      double* second = first + slot_size;
+      bisection.halve(pool.data() + par, static_cast<std::size_t>(vectors), top.state, first, second, states);
+      if (track_metric) {
+        const double* m = pool.data() + par + w_block;
+        const auto m_size = slot_size - w_block;
+        child_m_err = (top.m_err + m_bisection->halving_rounding_relative() * largest_magnitude(m, m_size) +
+                       m_bisection->halving_rounding_absolute()) *
+                      (1 + 1e-12);
+        BisectionState unused[2];
+        m_bisection->halve(m, static_cast<std::size_t>(m_vectors), top.state, first + w_block, second + w_block, unused);
+      }
     } else {
       // All vectors at once: each child's matrix is read once (bit-identical to one by one).
       for (std::size_t q = 0; q < children; ++q)
         basis.subdivide_many(static_cast<int>(q), pool.data() + par, static_cast<std::size_t>(vectors),
-                             scratch.children.data() + q * block, scratch.sub_scratch.data());
+                             scratch.children.data() + q * slot_size, scratch.sub_scratch.data());
     }
     free_slots.push_back(top.slot);
     for (std::size_t q = 0; q < children; ++q) {
@@ -331,16 +359,16 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
         free_slots.pop_back();
       } else {
         slot = next_slot++;
-        pool.resize(static_cast<std::size_t>(next_slot) * block);
+        pool.resize(static_cast<std::size_t>(next_slot) * slot_size);
       }
-      const auto child = static_cast<std::size_t>(slot) * block;
-      std::copy(scratch.children.begin() + static_cast<std::ptrdiff_t>(q * block),
-                scratch.children.begin() + static_cast<std::ptrdiff_t>((q + 1) * block),
+      const auto child = static_cast<std::size_t>(slot) * slot_size;
+      std::copy(scratch.children.begin() + static_cast<std::ptrdiff_t>(q * slot_size),
+                scratch.children.begin() + static_cast<std::ptrdiff_t>((q + 1) * slot_size),
                 pool.begin() + static_cast<std::ptrdiff_t>(child));
       const double corner = corner_ratio_upper(space, pool.data() + child, child_err, &scratch.corners, r_upper);
       r_upper = std::min(r_upper, corner);
-      const double lo = subdomain_lower(pool.data() + child, child_err, top.lower, std::min(corner, r_upper));
-      heap.push({lo, child_err, slot, halving ? states[q] : top.state});
+      const double lo = subdomain_lower(pool.data() + child, child_err, child_m_err, top.lower, std::min(corner, r_upper));
+      heap.push({lo, child_err, child_m_err, slot, halving ? states[q] : top.state});
     }
   }
   return out;

@@ -117,6 +117,32 @@ double MuMetric::control_lower_bound(const MuSpace& space, const double* w, doub
   return control_ratio_lower<3>(e, er, size);
 }
 
+double MuMetric::metric(const MuSpace& space, const double* w, double err, double* out) {
+  metric_entries(space, w, err);
+  const int dim = space.dim();
+  const std::array<int, 6> order = dim == 2 ? std::array<int, 6>{0, 1, 3, 0, 0, 0} : std::array<int, 6>{0, 1, 2, 3, 4, 5};
+  const std::size_t size = m_[0].c.size();
+  double e = 0;
+  for (int i = 0; i < metric_vectors(dim); ++i) {
+    const Poly& p = m_[order[static_cast<std::size_t>(i)]];
+    std::copy(p.c.begin(), p.c.end(), out + static_cast<std::size_t>(i) * size);
+    e = std::max(e, p.err);
+  }
+  return e;
+}
+
+double control_lower_bound_of_metric(int dim, const double* m, double err, int size) {
+  const auto at = [&](int i) { return m + static_cast<std::size_t>(i) * static_cast<std::size_t>(size); };
+  if (dim == 2) {
+    const double* e[3] = {at(0), at(1), at(2)};
+    const double er[3] = {err, err, err};
+    return control_ratio_lower<2>(e, er, size);
+  }
+  const double* e[6] = {at(0), at(1), at(2), at(3), at(4), at(5)};
+  const double er[6] = {err, err, err, err, err, err};
+  return control_ratio_lower<3>(e, er, size);
+}
+
 double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, double r_lo,
                              double r_hi, double r_target, double tol_r) {
   QV_ASSERT(space.has_certificate(), "no mu certificate for " << space.type().name);

@@ -64,6 +64,11 @@ class MuMetric {
   /// eigenvalue enclosure per control matrix. Same parameters as lower_bound.
   double control_lower_bound(const MuSpace& space, const double* w, double err);
 
+  /// The control values of M = W^T W's entries (degree 2n, space.size(2) each), in the
+  /// order m00, m11, (m22,) m01, (m02, m12), written to `out` one entry after the other.
+  /// @return a bound on |out - exact| for every value
+  double metric(const MuSpace& space, const double* w, double err, double* out);
+
  private:
   struct Poly {
     std::vector<double> c;
@@ -87,6 +92,14 @@ class MuMetric {
   bool invariant_form_ = false;
   std::vector<double> comb_;
 };
+
+/// Entries of M = W^T W per dimension: 3 in 2D, 6 in 3D.
+constexpr int metric_vectors(int dim) noexcept { return dim == 2 ? 3 : 6; }
+
+/// control_lower_bound from M's control values in MuMetric::metric's layout (size values
+/// per entry, all within err of the exact ones): a subdivided subdomain's M comes from its
+/// parent's by the same bisection as W, without products.
+double control_lower_bound_of_metric(int dim, const double* m, double err, int size);
 
 /// Certified upper bound of R at the subdomain's corners (the vertex control values of W
 /// are values of W): the Rayleigh quotients of W at approximate eigenvectors of W^T W,
