@@ -108,9 +108,10 @@ double control_lower_bound_of_metric(int dim, const double* m, double err, int s
 /// @param seen  optional: the W values (dim x 3, as laid out per corner) of corners already
 ///              bounded with an error bound at most `err`; a corner whose W equals one of
 ///              them bit for bit is skipped (its bound could only be the same or looser),
-///              and every corner evaluated is appended. Subdivision children share most
-///              corners with their parent and their siblings (a hexahedron's 8 children:
-///              64 corners, 27 points, 8 of them the parent's).
+///              and every corner not seen before is appended (also one skipped for
+///              `below`: its R stays above every later, smaller bound). Subdivision
+///              children share most corners with their parent and their siblings (a
+///              hexahedron's 8 children: 64 corners, 27 points, 8 of them the parent's).
 /// @param below  the result is at most this (an upper bound known already); a corner
 ///               whose R is certified to be at least the least bound so far
 ///               (ratio_at_least2/3 of mu_control_bound.hpp, on its metric) is not bounded,
