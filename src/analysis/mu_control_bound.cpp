@@ -303,19 +303,24 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
   // the r of the block's start; a matrix it certifies is at least that r, so at least the
   // current one, and is skipped as the scalar test would skip it (the test is monotone in
   // r). Only the others go through the scalar loop below, in order.
+  // A matrix the block test did not certify is tested again only if r has dropped since.
   unsigned certified = 0;  // bit l: matrix block_start + l certified
   int block_start = 0, block_end = 0;
+  double block_r = 1;
   for (int k = 0; k < size && r > 0; ++k) {
+    bool tested = false;
     if constexpr (D == 3) {
       if (r < 1 && k >= block_end && size - k >= 4) {
         block_start = k;
         block_end = std::min(k + 8, size);
+        block_r = r;
         Lanes<8> lanes[6];
         for (int i = 0; i < 6; ++i)
           for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
         certified = ratio_at_least3_lanes(lanes, e, r);
       }
       if (k < block_end && ((certified >> (k - block_start)) & 1u) != 0) continue;
+      tested = k < block_end && r == block_r;
     }
     for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
     // Most control matrices lie well above the least ratio found so far: certify that
@@ -324,7 +329,7 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
       if (r < 1 && ratio_at_least2(m, e, r)) continue;
     }
     if constexpr (D == 3) {
-      if (r < 1 && ratio_at_least3(m, e, r)) continue;
+      if (r < 1 && !tested && ratio_at_least3(m, e, r)) continue;
       double lo, hi;
       if (extreme_eigen_bounds3(m, e, lo, hi)) {
         r = std::min(r, lo > 0 ? std::clamp(next_down(lo / hi), 0.0, 1.0) : 0.0);
