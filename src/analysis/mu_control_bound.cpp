@@ -206,10 +206,6 @@ unsigned ratio_at_least3_lanes(const L8* m, double err, double r) {
   return mask;
 }
 
-}  // namespace
-
-namespace {
-
 // cos(acos(c) / 3) for c in [-1, 1], without trigonometric calls (acos and sincos were a
 // fifth of mu's time on linear hexahedra): the largest root x in [1/2, 1] of
 // 4 x^3 - 3 x = c, from a polynomial in s = sqrt((1 + c) / 2) (least squares on Chebyshev
