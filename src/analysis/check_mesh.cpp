@@ -156,17 +156,6 @@ std::string stage_name(std::size_t i) {
 
 CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, const std::string& file,
                                  const CheckSink& sink) {
-  if (const char* w = std::getenv("QV_PREWARM")) {
-    const int lvl = std::atoi(w);
-    for (const ElementBlock& b : mesh.blocks) {
-      if (b.type->dim != mesh.dimension() || !jacobian_supported(*b.type)) continue;
-      if (lvl >= 1) (void)jacobian_space(*b.type);
-      if (lvl >= 3) { QualityOptions q; q.abs_tol = 1e-2; const auto n = static_cast<std::size_t>(b.type->num_nodes) * 3;
-        std::vector<double> x(n); for (std::size_t k = 0; k < n / 3; ++k) for (int j = 0; j < 3; ++j) x[3*k+j] = mesh.coords[3*b.nodes[k]+j];
-        if (lvl == 3) (void)scaled_jacobian_bounds_given(*b.type, x, q, true, Validity::valid);
-        else (void)mu_bounds_given(*b.type, x, q, true, Validity::valid); }
-    }
-  }
   const double t0 = now_seconds();
   const StageClockRate tick_rate;
   double sink_seconds = 0;
