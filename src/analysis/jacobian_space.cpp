@@ -17,6 +17,7 @@
 
 #include "analysis/exact_inverse.hpp"
 #include "analysis/factor_shapes.hpp"
+#include "analysis/type_cache.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
 #include "quadval/error.hpp"
@@ -436,12 +437,8 @@ const std::vector<mpq_class>& JacobianSpace::exact_gradient(int c) const {
 }
 
 const JacobianSpace& jacobian_space(const ElementType& type) {
-  static std::mutex mutex;
-  static std::map<int, std::unique_ptr<const JacobianSpace>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[type.gmsh_id];
-  if (!slot) slot = std::make_unique<const JacobianSpace>(type);
-  return *slot;
+  static PerTypeCache<JacobianSpace> cache;
+  return cache.get(type, [&] { return std::make_unique<const JacobianSpace>(type); });
 }
 
 }  // namespace quadval

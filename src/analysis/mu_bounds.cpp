@@ -9,7 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <queue>
+#include <functional>
 #include <vector>
 
 #include "analysis/lane_vector.hpp"
@@ -46,6 +46,7 @@ struct MuScratch {
   std::vector<double> sub_scratch;
   std::vector<std::array<double, 9>> corners;  // W at the corners bounded in this split
   std::vector<double> children;                // the children of the subdomain refined
+  std::vector<Subdomain> heap;
 };
 
 // W's control values of the whole element (layout of MuMetric::lower_bound) and their
@@ -271,8 +272,8 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // matrices of its degree-2n space cost more (warped_tetrahedron_o3: 6% slower).
   const bool halving = type.family != ElementFamily::tetrahedron;
   const bool track_metric = halving && mode != 0;
-  const BernsteinBisection& bisection = bernstein_bisection(space.degrees(1));
-  const BernsteinBisection* m_bisection = track_metric ? &bernstein_bisection(space.degrees(2)) : nullptr;
+  const BernsteinBisection& bisection = space.bisection(1);
+  const BernsteinBisection* m_bisection = track_metric ? &space.bisection(2) : nullptr;
   const int vectors = space.dim() * 3;
   const int m_vectors = metric_vectors(space.dim());
   QV_ASSERT(!track_metric || m_bisection->size() == space.size(2), "M's space");
@@ -299,18 +300,25 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   const long levels = halving ? bisection.levels() : 1;
   const auto children = static_cast<std::size_t>(halving ? 2 : basis.num_children());
   long steps = 0;
-  std::priority_queue<Subdomain, std::vector<Subdomain>, std::greater<>> heap;
+  // A min-heap of subdomains by lower bound, in reused storage (std::priority_queue's own
+  // push_heap / pop_heap steps, so the same order).
+  std::vector<Subdomain>& heap = scratch.heap;
+  heap.clear();
+  const auto push = [&](const Subdomain& d) {
+    heap.push_back(d);
+    std::push_heap(heap.begin(), heap.end(), std::greater<>());
+  };
   double m_err0 = 0;
   if (track_metric) {
     pool.resize(slot_size);
     m_err0 = scratch.metric.metric(space, pool.data(), err0, pool.data() + w_block);
   }
-  heap.push({subdomain_lower(pool.data(), err0, m_err0, 0, r_upper), err0, m_err0, 0, bisection.root_state()});
+  push({subdomain_lower(pool.data(), err0, m_err0, 0, r_upper), err0, m_err0, 0, bisection.root_state()});
   int next_slot = 1;
   scratch.children.resize(children * slot_size);
   scratch.sub_scratch.resize(2 * static_cast<std::size_t>(basis.size()));
   while (true) {
-    const Subdomain top = heap.top();
+    const Subdomain top = heap.front();
     out.lower = sqrt_down(top.lower);
     out.upper = sqrt_up(r_upper);
     if (out.upper - out.lower <= options.abs_tol) {
@@ -318,7 +326,8 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       break;
     }
     if (steps >= static_cast<long>(options.max_subdivisions) * levels) break;
-    heap.pop();
+    std::pop_heap(heap.begin(), heap.end(), std::greater<>());
+    heap.pop_back();
     ++steps;
     out.subdivisions = static_cast<int>((steps + levels - 1) / levels);
     const auto par = static_cast<std::size_t>(top.slot) * slot_size;
@@ -370,7 +379,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       const double corner = corner_ratio_upper(space, pool.data() + child, child_err, &scratch.corners, r_upper);
       r_upper = std::min(r_upper, corner);
       const double lo = subdomain_lower(pool.data() + child, child_err, child_m_err, top.lower, std::min(corner, r_upper));
-      heap.push({lo, child_err, child_m_err, slot, halving ? states[q] : top.state});
+      push({lo, child_err, child_m_err, slot, halving ? states[q] : top.state});
     }
   }
   return out;

@@ -15,6 +15,7 @@
 #include "analysis/factor_shapes.hpp"
 #include "analysis/product_tables.hpp"
 #include "analysis/pyramid_space.hpp"
+#include "analysis/type_cache.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "mesh/polynomial_space.hpp"
@@ -171,6 +172,8 @@ void MuSpace::init_w_space(const std::vector<int>& factor_dims, int n) {
   for (int m : multiples) sizes_[m] = bernstein_space_size(degrees_[m]);
   w_basis_ = std::make_unique<BezierBasis>(type_->family, type_->order, w_factors);
   prod11_ = &bernstein_product(degrees_[1], degrees_[1]);
+  bisection_[0] = &bernstein_bisection(degrees_[1]);
+  bisection_[1] = &bernstein_bisection(degrees_[2]);
   ideal_inv_ = ideal_inverse_of(type_->family);
 }
 
@@ -419,12 +422,8 @@ const BernsteinProduct& MuSpace::prod(int a, int b) const {
 }
 
 const MuSpace& mu_space(const ElementType& type) {
-  static std::mutex mutex;
-  static std::map<int, std::unique_ptr<const MuSpace>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[type.gmsh_id];
-  if (!slot) slot = std::make_unique<const MuSpace>(type);
-  return *slot;
+  static PerTypeCache<MuSpace> cache;
+  return cache.get(type, [&] { return std::make_unique<const MuSpace>(type); });
 }
 
 }  // namespace quadval

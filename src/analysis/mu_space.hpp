@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/jacobian_product.hpp"
+#include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
@@ -78,6 +79,9 @@ class MuSpace {
   /// certificate only m in {1, 2} (the others are empty, their sizes 0).
   const std::vector<FactorDegree>& degrees(int m) const noexcept { return degrees_[m]; }
   int size(int m) const noexcept { return sizes_[m]; }
+  /// The bisections of W's space (m = 1) and of M's (m = 2), looked up once here rather
+  /// than per element (bernstein_bisection's keyed, locked cache).
+  const BernsteinBisection& bisection(int m) const noexcept { return *bisection_[m == 1 ? 0 : 1]; }
 
   /// Control value k of dX/dxi_c (Gmsh reference coordinates; pyramids: as a polynomial
   /// in the cube coordinates, analysis/pyramid_space.hpp) = sum_i
@@ -117,6 +121,7 @@ class MuSpace {
   double row_sum_[3] = {};
   std::array<double, 9> ideal_inv_{};
   const BernsteinProduct* prod11_ = nullptr;  // (1, 1): the control matrices of M
+  const BernsteinBisection* bisection_[2] = {};  // degrees (1) and (2)
   void build_certificate_products() const;
   mutable std::once_flag certificate_once_;
   mutable std::vector<std::pair<std::pair<int, int>, const BernsteinProduct*>> certificate_prod_;

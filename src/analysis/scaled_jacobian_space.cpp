@@ -4,13 +4,12 @@
 #include "analysis/scaled_jacobian_space.hpp"
 
 #include <cmath>
-#include <map>
 #include <memory>
-#include <mutex>
 
+#include "analysis/jacobian_product.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
-#include "analysis/jacobian_product.hpp"
+#include "analysis/type_cache.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
 #include "quadval/scaled_jacobian.hpp"
@@ -206,12 +205,8 @@ void ScaledJacobianSpace::init_pyramid() {
 }
 
 const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type) {
-  static std::mutex mutex;
-  static std::map<int, std::unique_ptr<const ScaledJacobianSpace>> cache;
-  std::lock_guard<std::mutex> lock(mutex);
-  auto& slot = cache[type.gmsh_id];
-  if (!slot) slot = std::make_unique<const ScaledJacobianSpace>(type);
-  return *slot;
+  static PerTypeCache<ScaledJacobianSpace> cache;
+  return cache.get(type, [&] { return std::make_unique<const ScaledJacobianSpace>(type); });
 }
 
 }  // namespace quadval
