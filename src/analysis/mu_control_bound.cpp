@@ -206,6 +206,31 @@ unsigned ratio_at_least3_lanes(const L8* m, double err, double r) {
   return mask;
 }
 
+// symmetric_eigen_enclosure<2>(m, err).ratio_lower() of 8 matrices at once (lane l:
+// entries m[i][l]), each lane with the scalar functions' operations in the same order
+// (bit-identical per matrix).
+L8 enclosure_ratio_lower2_lanes(const L8* m, double err) {
+  const L8 zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
+  const L8 rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
+  const L8 s_hi = next_up8(vabs(s) + rq), s_lo = vmax(zero, next_down8(vabs(s) - rq));
+  const L8 t_hi = next_up8(vabs(t) + err), t_lo = vmax(zero, next_down8(vabs(t) - err));
+  L8 d_hi = next_up8(next_up8(s_hi * s_hi) + next_up8(t_hi * t_hi));
+  L8 d_lo = vmax(zero, next_down8(next_down8(s_lo * s_lo) + next_down8(t_lo * t_lo)));
+  for (int l = 0; l < 8; ++l) {  // vsqrtpd: exact rounding, as std::sqrt
+    d_hi[l] = std::sqrt(d_hi[l]);
+    d_lo[l] = std::sqrt(d_lo[l]);
+  }
+  d_hi = next_up8(d_hi);
+  d_lo = vmax(zero, next_down8(d_lo));
+  const L8 q_lo = next_down8(q - rq), q_hi = next_up8(q + rq);
+  const L8 min_lo = next_down8(q_lo - d_hi), max_hi = next_up8(q_hi + d_hi);
+  constexpr double kMax = std::numeric_limits<double>::max();
+  // An enclosure that is unknown (a non-finite step) or not positive: ratio 0.
+  const auto known = (vabs(q_lo) <= kMax) & (vabs(q_hi) <= kMax) & (vabs(d_hi) <= kMax) & (min_lo > 0) & (max_hi < kInf);
+  const L8 ratio = next_down8(min_lo / max_hi);
+  return known ? vmin(vmax(ratio, zero), L8{} + 1) : zero;
+}
+
 // cos(acos(c) / 3) for c in [-1, 1], without trigonometric calls (acos and sincos were a
 // fifth of mu's time on linear hexahedra): the largest root x in [1/2, 1] of
 // 4 x^3 - 3 x = c, from a polynomial in s = sqrt((1 + c) / 2) (least squares on Chebyshev
@@ -308,6 +333,19 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
   constexpr int kEntries = D * (D + 1) / 2;
   double e = 0;
   for (int i = 0; i < kEntries; ++i) e = std::max(e, err[i]);
+  // 2D: every matrix's enclosure, 8 at a time, branch-free (the closed form is about as
+  // cheap as the test that would skip it; the last block repeats matrix 0 in its spare
+  // lanes).
+  if constexpr (D == 2) {
+    double r = 1;
+    for (int k = 0; k < size; k += 8) {
+      L8 lanes[3];
+      for (int i = 0; i < 3; ++i)
+        for (int l = 0; l < 8; ++l) lanes[i][l] = entries[i][k + l < size ? k + l : 0];
+      r = fold_min(enclosure_ratio_lower2_lanes(lanes, e), r);
+    }
+    return r;
+  }
   double r = 1;
   double m[kEntries];
   const auto enclose = [&](int k) {

@@ -15,7 +15,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <random>
+#include <vector>
 
 #include "analysis/mu_control_bound.hpp"
 #include "analysis/mu_metric.hpp"
@@ -211,6 +213,40 @@ TEST(MuControlBound, ControlRatioIsMinimumOverControlMatrices) {
   const double r = control_ratio_lower<3>(e, err, 2);
   EXPECT_LE(r, 1.0 / 9);
   EXPECT_NEAR(r, 1.0 / 9, 1e-11);  // the certification margins are 1e-12 relative
+}
+
+// 2D: the least ratio_lower of every control matrix's enclosure, bit for bit, whatever the
+// count (lane blocks of 8 and a partial last one), on sets from nearly isotropic to
+// stretched, some with an indefinite matrix (ratio 0) or an error radius.
+TEST(MuControlBound, ControlRatio2IsTheLeastEnclosureOfEveryMatrix) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int n : {1, 3, 7, 8, 9, 16, 17, 25, 28}) {
+    for (int trial = 0; trial < 40; ++trial) {
+      const double stretch = trial % 4 == 0 ? 0.99 : trial % 4 == 1 ? 0.5 : trial % 4 == 2 ? 0.05 : 1e-6;
+      std::array<std::vector<double>, 3> entries;
+      double least = 1;
+      for (int k = 0; k < n; ++k) {
+        const double angle = 3.2 * u(rng), c = std::cos(angle), s = std::sin(angle);
+        const double l0 = 1 + 0.1 * u(rng);
+        double l1 = stretch * (1 + 0.1 * u(rng));
+        if (trial % 7 == 3 && k == n / 2) l1 = -0.01;  // one indefinite matrix
+        entries[0].push_back(c * c * l0 + s * s * l1);
+        entries[1].push_back(s * s * l0 + c * c * l1);
+        entries[2].push_back(c * s * (l0 - l1));
+      }
+      const double err = trial % 3 == 0 ? 1e-9 : 0.0;
+      const double errs[3] = {err, err / 2, err};
+      const double* e[3] = {entries[0].data(), entries[1].data(), entries[2].data()};
+      for (int k = 0; k < n; ++k) {
+        const double m[3] = {entries[0][static_cast<std::size_t>(k)], entries[1][static_cast<std::size_t>(k)],
+                             entries[2][static_cast<std::size_t>(k)]};
+        least = std::min(least, symmetric_eigen_enclosure<2>(m, err).ratio_lower());
+      }
+      SCOPED_TRACE(testing::Message() << "n " << n << " trial " << trial);
+      EXPECT_EQ(control_ratio_lower<2>(e, errs, n), least);
+    }
+  }
 }
 
 // lambda_min(M) >= r lambda_max(M) for a symmetric 3 x 3 M, exactly: the eigenvalues of
