@@ -151,12 +151,20 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
   return *cache.back().second;
 }
 
+// Working arrays of Quotient, kept per thread from element to element (as members they
+// were allocated and freed for every element).
+struct QuotientScratch {
+  std::vector<double> sumsq, part, scratch, big, spread;
+  std::vector<std::size_t> first, col0;
+  std::vector<BisectionState> column_states;
+};
+
 // The leaves' data: per leaf J then the columns' coordinates, contiguous; per leaf the
 // error bounds of J and of each column, and its bisection state.
 class Quotient {
  public:
-  Quotient(const ScaledJacobianSpace& space, const QuotientInput& in)
-      : space_(space), in_(in), layout_(layout_of(space, in)) {
+  Quotient(const ScaledJacobianSpace& space, const QuotientInput& in, QuotientScratch& ws)
+      : space_(space), in_(in), layout_(layout_of(space, in)), ws_(ws) {
     dim_ = static_cast<std::size_t>(space.dim());
     QV_ASSERT(layout_.offset[1] == in.j.size() && layout_.size[0] == in.col[0][0].size(),
               "the layout of another input");
@@ -185,11 +193,11 @@ class Quotient {
     // Each distinct frame column: the squared norms of its control points, their largest,
     // and the spread of its norms from the columns' errors.
     const std::size_t nd = layout_.distinct.size();
-    sumsq_.clear();
-    first_.resize(nd);
-    col0_.resize(nd);
-    big_.resize(nd);
-    spread_.resize(nd);
+    ws_.sumsq.clear();
+    ws_.first.resize(nd);
+    ws_.col0.resize(nd);
+    ws_.big.resize(nd);
+    ws_.spread.resize(nd);
     for (std::size_t d = 0; d < nd; ++d) {
       const FrameColumn& f = layout_.distinct[d];
       double e = 0;
@@ -197,10 +205,10 @@ class Quotient {
         const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
         e += err[c + 1] + gamma_ * in_.col_magnitude[c];
       }
-      spread_[d] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
-      col0_[d] = static_cast<std::size_t>(f.column[0]);
-      const std::size_t n = layout_.size[col0_[d]];
-      first_[d] = sumsq_.size();
+      ws_.spread[d] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
+      ws_.col0[d] = static_cast<std::size_t>(f.column[0]);
+      const std::size_t n = layout_.size[ws_.col0[d]];
+      ws_.first[d] = ws_.sumsq.size();
       double big = 0;
       for (std::size_t i = 0; i < n; ++i) {
         double sum = 0;
@@ -212,23 +220,23 @@ class Quotient {
           }
           sum += v * v;
         }
-        sumsq_.push_back(sum);
+        ws_.sumsq.push_back(sum);
         big = std::max(big, sum);
       }
-      big_[d] = big;
+      ws_.big[d] = big;
     }
     double lower = kInf;
     for (const auto& fr : layout_.frames) {
       double norm_product = 1;
       for (std::size_t j = 0; j < dim_; ++j)
-        norm_product = up(norm_product * up(up(std::sqrt(big_[fr[j]]) * (1 + 1e-12)) + spread_[fr[j]]));
+        norm_product = up(norm_product * up(up(std::sqrt(ws_.big[fr[j]]) * (1 + 1e-12)) + ws_.spread[fr[j]]));
       // J > 0 on the element: sj > 0 everywhere, the bound where J_lo is not positive.
       lower = std::min(lower, j_lo > 0 ? down(space_.s_lo() * down(j_lo / norm_product)) : 0.0);
       // The corner of least sj estimated from the squares (any corner gives a true upper
       // bound; the estimate only picks a sharp one), then certified there.
       const auto square_at = [&](std::size_t j, std::size_t m) {
         const std::size_t d = fr[j];
-        return sumsq_[first_[d] + static_cast<std::size_t>(layout_.col_tools[col0_[d]]->corners[m])];
+        return ws_.sumsq[ws_.first[d] + static_cast<std::size_t>(layout_.col_tools[ws_.col0[d]]->corners[m])];
       };
       std::size_t best = corners;
       double best_square = kInf;
@@ -244,7 +252,7 @@ class Quotient {
       if (best == corners) continue;
       double denominator = 1;
       for (std::size_t j = 0; j < dim_; ++j) {
-        const double norm_lo = down(down(std::sqrt(square_at(j, best)) * (1 - 1e-12)) - spread_[fr[j]]);
+        const double norm_lo = down(down(std::sqrt(square_at(j, best)) * (1 - 1e-12)) - ws_.spread[fr[j]]);
         denominator = norm_lo > 0 ? down(denominator * norm_lo) : 0;
       }
       if (!(denominator > 0)) continue;  // a column may vanish there: no value from this corner
@@ -267,18 +275,18 @@ class Quotient {
       return up((e + b.rounding_relative() * largest_magnitude(v, n) + b.rounding_absolute()) * (1 + 1e-12));
     };
     const std::size_t sj = in_.j.size();
-    part_.resize(nc * layout_.stride);  // any one part's children: layout_.stride >= J's and 3 x a column's size
-    jb.split(leaf, 1, state, part_.data(), states.data(), scratch_);
-    for (std::size_t q = 0; q < nc; ++q) std::copy_n(part_.data() + q * sj, sj, children.data() + q * layout_.stride);
+    ws_.part.resize(nc * layout_.stride);  // any one part's children: layout_.stride >= J's and 3 x a column's size
+    jb.split(leaf, 1, state, ws_.part.data(), states.data(), ws_.scratch);
+    for (std::size_t q = 0; q < nc; ++q) std::copy_n(ws_.part.data() + q * sj, sj, children.data() + q * layout_.stride);
     child_err[0] = child_error(jb, err[0], leaf, sj);
     for (std::size_t c = 0; c < dim_; ++c) {
       const BernsteinBisection& cb = *layout_.col_tools[c]->bisection;
       const std::size_t block = 3 * layout_.size[c];
       const double* parent = leaf + layout_.offset[c + 1];
-      column_states_.resize(nc);
-      cb.split(parent, 3, state, part_.data(), column_states_.data(), scratch_);
+      ws_.column_states.resize(nc);
+      cb.split(parent, 3, state, ws_.part.data(), ws_.column_states.data(), ws_.scratch);
       for (std::size_t q = 0; q < nc; ++q)
-        std::copy_n(part_.data() + q * block, block, children.data() + q * layout_.stride + layout_.offset[c + 1]);
+        std::copy_n(ws_.part.data() + q * block, block, children.data() + q * layout_.stride + layout_.offset[c + 1]);
       child_err[c + 1] = child_error(cb, err[c + 1], parent, block);
     }
   }
@@ -291,9 +299,7 @@ class Quotient {
   const QuotientLayout& layout_;
   std::size_t dim_ = 0;
   const double gamma_ = rounding_gamma(6);  // of a frame column's sum of <= 3 columns
-  mutable std::vector<double> sumsq_, part_, scratch_, big_, spread_;
-  mutable std::vector<std::size_t> first_, col0_;
-  mutable std::vector<BisectionState> column_states_;
+  QuotientScratch& ws_;
 };
 
 }  // namespace
@@ -304,7 +310,8 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
   out.lower = -kInf;
   out.upper = space.s_hi();
   if (!(down(*std::min_element(in.j.begin(), in.j.end()) - in.j_error) > 0)) return out;
-  const Quotient q(space, in);
+  thread_local QuotientScratch scratch;
+  const Quotient q(space, in, scratch);
   const std::size_t stride = q.stride();
   thread_local std::vector<double> pool, children;
   thread_local std::vector<std::array<double, 4>> pool_err;
