@@ -313,17 +313,92 @@ bool ratio_at_least2(const double* m, double err, double r) {
   return lhs * (1 - kGamma) > rhs * (1 + kGamma);
 }
 
-namespace {
-
-// A cheap estimate of the ratio of control matrix k (not certified: it only picks the
-// matrix enclosed first): det M / (tr M / 3)^3, 1 for a multiple of I, at most 0 for an
-// indefinite M.
-double ratio_estimate3(const double* const* m, int k) {
-  const double a = m[0][k], b = m[1][k], c = m[2][k], d = m[3][k], e = m[4][k], f = m[5][k];
+double ratio_estimate3(const double* m) {
+  const double a = m[0], b = m[1], c = m[2], d = m[3], e = m[4], f = m[5];
   const double t = (a + b + c) / 3;
   const double det = a * (b * c - f * f) - d * (d * c - f * e) + e * (d * f - b * e);
   const double est = det / (t * t * t);
   return t > 0 && std::isfinite(est) ? est : -1.0;
+}
+
+namespace {
+
+// 2D: every matrix's enclosure, 8 at a time, branch-free (the closed form is about as
+// cheap as the test that would skip it; the last block repeats matrix 0 in its spare
+// lanes).
+double control_ratio_lower2(const double* const* entries, double e, int size) {
+  double r = 1;
+  for (int k = 0; k < size; k += 8) {
+    L8 lanes[3];
+    for (int i = 0; i < 3; ++i) {
+      if (size - k >= 8) {
+        lanes[i] = load_lanes<8>(entries[i] + k);
+        continue;
+      }
+      double tail[8];
+      for (int l = 0; l < 8; ++l) tail[l] = entries[i][k + l < size ? k + l : 0];
+      lanes[i] = load_lanes<8>(tail);
+    }
+    r = fold_min(enclosure_ratio_lower2_lanes(lanes, e), r);
+  }
+  return r;
+}
+
+double control_ratio_lower3(const double* const* entries, double e, int size) {
+  double r = 1;
+  double m[6];
+  const auto load = [&](int k) {
+    for (int i = 0; i < 6; ++i) m[i] = entries[i][k];
+  };
+  const auto enclose = [&](int k) {
+    load(k);
+    double lo, hi;
+    if (extreme_eigen_bounds3(m, e, lo, hi))
+      r = std::min(r, lo > 0 ? std::clamp(next_down(lo / hi), 0.0, 1.0) : 0.0);
+    else
+      r = std::min(r, symmetric_eigen_enclosure<3>(m, e).ratio_lower());
+  };
+  // The matrix of least estimated ratio is enclosed first, so that the cheap test below
+  // certifies most others against an r near the final one (hex_box: 4.8 enclosures per
+  // subdomain when starting from the first matrix).
+  int first = -1;
+  if (size > 1) {
+    double least = kInf;
+    for (int k = 0; k < size; ++k) {
+      load(k);
+      const double est = ratio_estimate3(m);
+      if (est < least) least = est, first = k;
+    }
+    if (first >= 0) enclose(first);
+  }
+  // Once a ratio is certified, the cheap test runs on 8 control matrices at once with the
+  // r of the block's start; a matrix it certifies is at least that r, so at least the
+  // current one, and is skipped as the scalar test would skip it (the test is monotone in
+  // r). Only the others go through the scalar test below, in order; a matrix the block
+  // test did not certify is tested again only if r has dropped since. Most control
+  // matrices lie well above the least ratio found so far: certifying that cheaply skips
+  // their eigenvalue enclosure (r stays a lower bound of their ratios).
+  unsigned certified = 0;  // bit l: matrix block_start + l certified
+  int block_start = 0, block_end = 0;
+  double block_r = 1;
+  for (int k = 0; k < size && r > 0; ++k) {
+    if (k == first) continue;
+    if (r < 1 && k >= block_end && size - k >= 4) {
+      block_start = k;
+      block_end = std::min(k + 8, size);
+      block_r = r;
+      Lanes<8> lanes[6];
+      for (int i = 0; i < 6; ++i)
+        for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
+      certified = ratio_at_least3_lanes(lanes, e, r);
+    }
+    if (k < block_end && ((certified >> (k - block_start)) & 1u) != 0) continue;
+    const bool tested = k < block_end && r == block_r;
+    load(k);
+    if (r < 1 && !tested && ratio_at_least3(m, e, r)) continue;
+    enclose(k);
+  }
+  return r;
 }
 
 }  // namespace
@@ -333,82 +408,7 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
   constexpr int kEntries = D * (D + 1) / 2;
   double e = 0;
   for (int i = 0; i < kEntries; ++i) e = std::max(e, err[i]);
-  // 2D: every matrix's enclosure, 8 at a time, branch-free (the closed form is about as
-  // cheap as the test that would skip it; the last block repeats matrix 0 in its spare
-  // lanes).
-  if constexpr (D == 2) {
-    double r = 1;
-    for (int k = 0; k < size; k += 8) {
-      L8 lanes[3];
-      for (int i = 0; i < 3; ++i)
-        for (int l = 0; l < 8; ++l) lanes[i][l] = entries[i][k + l < size ? k + l : 0];
-      r = fold_min(enclosure_ratio_lower2_lanes(lanes, e), r);
-    }
-    return r;
-  }
-  double r = 1;
-  double m[kEntries];
-  const auto enclose = [&](int k) {
-    for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
-    if constexpr (D == 3) {
-      double lo, hi;
-      if (extreme_eigen_bounds3(m, e, lo, hi)) {
-        r = std::min(r, lo > 0 ? std::clamp(next_down(lo / hi), 0.0, 1.0) : 0.0);
-        return;
-      }
-    }
-    r = std::min(r, symmetric_eigen_enclosure<D>(m, e).ratio_lower());
-  };
-  // 3D: the matrix of least estimated ratio is enclosed first, so that the cheap test
-  // below certifies most others against an r near the final one (hex_box: 4.8 enclosures
-  // per subdomain when starting from the first matrix).
-  int first = -1;
-  if constexpr (D == 3) {
-    if (size > 1) {
-      double least = kInf;
-      for (int k = 0; k < size; ++k) {
-        const double est = ratio_estimate3(entries, k);
-        if (est < least) least = est, first = k;
-      }
-      if (first >= 0) enclose(first);
-    }
-  }
-  // 3D: once a ratio is certified, the cheap test runs on 8 control matrices at once with
-  // the r of the block's start; a matrix it certifies is at least that r, so at least the
-  // current one, and is skipped as the scalar test would skip it (the test is monotone in
-  // r). Only the others go through the scalar loop below, in order.
-  // A matrix the block test did not certify is tested again only if r has dropped since.
-  unsigned certified = 0;  // bit l: matrix block_start + l certified
-  int block_start = 0, block_end = 0;
-  double block_r = 1;
-  for (int k = 0; k < size && r > 0; ++k) {
-    if (k == first) continue;
-    bool tested = false;
-    if constexpr (D == 3) {
-      if (r < 1 && k >= block_end && size - k >= 4) {
-        block_start = k;
-        block_end = std::min(k + 8, size);
-        block_r = r;
-        Lanes<8> lanes[6];
-        for (int i = 0; i < 6; ++i)
-          for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
-        certified = ratio_at_least3_lanes(lanes, e, r);
-      }
-      if (k < block_end && ((certified >> (k - block_start)) & 1u) != 0) continue;
-      tested = k < block_end && r == block_r;
-    }
-    for (int i = 0; i < kEntries; ++i) m[i] = entries[i][k];
-    // Most control matrices lie well above the least ratio found so far: certify that
-    // cheaply and skip their eigenvalue enclosure (r stays a lower bound of their ratios).
-    if constexpr (D == 2) {
-      if (r < 1 && ratio_at_least2(m, e, r)) continue;
-    }
-    if constexpr (D == 3) {
-      if (r < 1 && !tested && ratio_at_least3(m, e, r)) continue;
-    }
-    enclose(k);
-  }
-  return r;
+  return D == 2 ? control_ratio_lower2(entries, e, size) : control_ratio_lower3(entries, e, size);
 }
 
 template double control_ratio_lower<2>(const double* const*, const double*, int);

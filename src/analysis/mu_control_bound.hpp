@@ -73,10 +73,17 @@ bool ratio_at_least2(const double* m, double err, double r);
 /// @pre 0 <= r < 1
 bool ratio_at_least3(const double* m, double err, double r);
 
+/// A cheap estimate of the ratio lambda_min / lambda_max of a symmetric 3 x 3 matrix
+/// (entries as above), not certified: it only orders matrices so that the least ratio is
+/// usually met first. det M / (tr M / 3)^3: 1 for a multiple of I, at most 0 for an
+/// indefinite M, -1 when tr M <= 0 or the quotient is not finite.
+double ratio_estimate3(const double* m);
+
 /// Certified lower bound of min R over a subdomain (the concavity argument above): the
-/// least certified ratio over the control matrices. A matrix whose ratio is certified to
-/// be at least the least one so far without eigenvalues (Laguerre-Samuelson bound of
-/// lambda_max, then Sylvester's criterion on M - r lambda_max I) skips its enclosure.
+/// least certified ratio over the control matrices. 2D: every matrix's closed-form
+/// enclosure. 3D: a matrix whose ratio is certified to be at least the least one so far
+/// without eigenvalues (Laguerre-Samuelson bound of lambda_max, then Sylvester's criterion
+/// on M - r lambda_max I) skips its enclosure.
 /// @param entries  D (D + 1) / 2 coefficient vectors of `size` control values each, in the
 ///                 order of symmetric_eigen_enclosure (m00, m11, (m22,) m01, ...)
 /// @param err      per entry vector, |exact control value - computed| <= err[i]

@@ -549,14 +549,9 @@ CornerMetric corner_metric(const std::array<double, 9>& w, int dim, double err) 
 // the least bound is usually found first): det M / (tr M / dim)^dim, 1 for isotropic M.
 double corner_estimate(const CornerMetric& cm, int dim) {
   const auto& m = cm.m;
-  if (dim == 2) {
-    const double t = 0.5 * (m[0] + m[1]);
-    return (m[0] * m[1] - m[2] * m[2]) / (t * t);
-  }
-  const double t = (m[0] + m[1] + m[2]) / 3;
-  const double det = m[0] * (m[1] * m[2] - m[5] * m[5]) - m[3] * (m[3] * m[2] - m[5] * m[4]) +
-                     m[4] * (m[3] * m[5] - m[1] * m[4]);
-  return det / (t * t * t);
+  if (dim == 3) return ratio_estimate3(m.data());
+  const double t = 0.5 * (m[0] + m[1]);
+  return (m[0] * m[1] - m[2] * m[2]) / (t * t);
 }
 
 }  // namespace
