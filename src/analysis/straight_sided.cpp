@@ -98,12 +98,14 @@ void StraightSidedMargin::lane_margins(const At& at, double* out, double* beta_o
   const auto nn = static_cast<std::size_t>(num_nodes_);
   const auto nv = static_cast<std::size_t>(num_vertices_);
   const auto axes = static_cast<std::size_t>(axes_);
-  // y_v = x_v - x_0 of the vertices, and sum_v |y_v| per axis.
-  V x0[3], y[8][3], vertex_sum[3] = {};
-  for (std::size_t j = 0; j < axes; ++j) x0[j] = at(0, j);
+  // The vertices, gathered once; y_v = x_v - x_0, and sum_v |y_v| per axis.
+  V xv[8][3], y[8][3], vertex_sum[3] = {};
+  for (std::size_t v = 0; v < nv; ++v)
+    for (std::size_t j = 0; j < axes; ++j) xv[v][j] = at(v, j);
+  const V* x0 = xv[0];
   for (std::size_t v = 1; v < nv; ++v)
     for (std::size_t j = 0; j < axes; ++j) {
-      y[v][j] = at(v, j) - x0[j];
+      y[v][j] = xv[v][j] - x0[j];
       vertex_sum[j] += vabs(y[v][j]);
     }
   // alpha_c: the largest 1-norm of the edges of direction c (halved on [-1, 1]).
@@ -114,7 +116,7 @@ void StraightSidedMargin::lane_margins(const At& at, double* out, double* beta_o
     for (int k = 0; k < dirs[c].edges; ++k) {
       const auto from = static_cast<std::size_t>(dirs[c].from[k]), to = static_cast<std::size_t>(dirs[c].to[k]);
       V norm = {};  // from the coordinates: one rounding per component, however far from x_0
-      for (std::size_t j = 0; j < axes; ++j) norm += vabs(at(to, j) - at(from, j));
+      for (std::size_t j = 0; j < axes; ++j) norm += vabs(xv[to][j] - xv[from][j]);
       alpha[c] = vmax(alpha[c], norm);
       finite += norm;
     }
