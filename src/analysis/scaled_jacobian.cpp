@@ -245,8 +245,8 @@ struct ProductTerm {
 // The shared table of (f, g), looked up once per thread and degree pair (no lock, no
 // allocation per product). The key packs each factor's dimension and degree of both
 // operands, 10 bits each (at most 3 factors, degrees below 256): a linear search over the
-// few pairs in use (a std::map keyed by 12 ints was a tenth of the time on linear
-// hexahedra).
+// few pairs in use (against a std::map keyed by 12 ints: hex_box sj, one thread, fastest
+// of 15, 27.6 -> 27.0 ms).
 const BernsteinProduct& product_table(const Poly& f, const Poly& g) {
   thread_local std::vector<std::pair<std::uint64_t, const BernsteinProduct*>> tables;
   QV_ASSERT(f.deg.size() <= 3 && f.deg.size() == g.deg.size(), f.deg.size() << " factors");
