@@ -8,6 +8,8 @@
 #include "analysis/jacobian_engine.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/lane_vector.hpp"
+#include "analysis/midpoint_probe.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/ratio_refinement.hpp"
 #include "bezier/rational_rounding.hpp"
@@ -214,7 +216,14 @@ JacobianBounds bounds_from_coefficients(const JacobianSpace& space, const double
   const auto s = static_cast<std::size_t>(space.basis().size());
   ws.coeffs.assign(coeffs, coeffs + s);
   double value_upper = kInf;
-  const bool invalid = vertex_value_invalid(space.basis(), coeffs, err, value_upper);
+  bool invalid = vertex_value_invalid(space.basis(), coeffs, err, value_upper);
+  // Validity, where the coefficients leave the sign open: J at the midpoints before any
+  // subdivision (midpoint_probe.hpp); a value J <= 0 there decides the element as a sample
+  // would (stage 0).
+  if (!invalid && options.goal == BoundsGoal::validity && !(down(least_value(coeffs, s) - err) > 0)) {
+    value_upper = std::min(value_upper, midpoint_probe_upper(space.basis(), coeffs, err));
+    invalid = value_upper <= 0;
+  }
   return bounds_from_first_coefficients(space, err, invalid, value_upper, nodes, planar, options, ws);
 }
 

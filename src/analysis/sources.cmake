@@ -7,6 +7,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/jacobian_product.cpp
   src/analysis/jacobian_engine.cpp
   src/analysis/jacobian_bounds.cpp
+  src/analysis/midpoint_probe.cpp
   src/analysis/linear_jacobian.cpp
   src/analysis/straight_sided.cpp
   src/analysis/check_mesh.cpp

@@ -9,6 +9,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/mu_high_order_test.cpp
   analysis/pyramid_quality_test.cpp
   analysis/jacobian_bounds_test.cpp
+  analysis/midpoint_probe_test.cpp
   analysis/jacobian_exact_test.cpp
   analysis/gmsh_agreement_test.cpp
   analysis/gmsh_high_order_test.cpp
