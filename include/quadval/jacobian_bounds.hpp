@@ -73,8 +73,10 @@ struct JacobianBounds {
   double javg = 0;
   Validity validity = Validity::undetermined;
   int subdivisions = 0;  ///< subdivisions (for min J, plus for max J when measuring)
-  /// Which stage decided validity (Paper III Table 2): 0 the samples, 1 the first Bézier
-  /// coefficients, 1 + k after k levels of subdivision; -1 when undetermined.
+  /// Which stage decided validity (Paper III Table 2): 0 the samples (values of J: at the
+  /// sample points, the corners, or, in validity checks, the midpoints a first subdivision
+  /// would reach), 1 the first Bézier coefficients, 1 + k after k levels of subdivision;
+  /// -1 when undetermined.
   int stage = -1;
   bool exact = false;           ///< the exact-arithmetic fallback decided the sign
   bool tolerance_met = true;    ///< measure goal: both gaps within the tolerance
