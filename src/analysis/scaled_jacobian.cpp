@@ -581,10 +581,10 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   // times 1 in the space of |v_a|^2 to reach the squared space (3D only: in 2D |V_k| =
   // |v_a| |v_b| sin, and dividing out leaves nothing below -s).
   const bool hadamard_frames = !valid && dim == 3;
-  std::vector<bool> hadamard(frames, false);
+  QV_ASSERT(frames <= LeafFrames::kMax, frames << " frames");
+  std::array<bool, LeafFrames::kMax> hadamard{};
   auto& had = polys.hadamard;
   had.resize(2 * frames);
-  QV_ASSERT(frames <= LeafFrames::kMax, frames << " frames");
   for (std::size_t f = 0; f < frames; ++f) {
     const Frame& fr = space.frames()[f];
     std::array<std::size_t, 3> d{};
@@ -627,19 +627,20 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   }
 
   // 3. The root, slot 0 of the leaf pool: its vectors in the order of LeafFrames.
-  std::vector<const Poly*> vectors;
-  if (!valid) vectors.push_back(&jsq);
-  vectors.push_back(&n);
+  // At most J, N and three vectors per frame; fixed arrays, as this runs per element.
+  std::array<const Poly*, 2 + 3 * LeafFrames::kMax> vectors{};
+  std::size_t nvec = 0;
+  if (!valid) vectors[nvec++] = &jsq;
+  vectors[nvec++] = &n;
   LeafFrames root_frames;
   for (std::size_t f = 0; f < frames; ++f) {
     root_frames.width[root_frames.count++] = hadamard[f] ? 3 : 1;
-    vectors.push_back(&dk[f]);
+    vectors[nvec++] = &dk[f];
     if (hadamard[f]) {
-      vectors.push_back(&had[2 * f]);
-      vectors.push_back(&had[2 * f + 1]);
+      vectors[nvec++] = &had[2 * f];
+      vectors[nvec++] = &had[2 * f + 1];
     }
   }
-  const std::size_t nvec = vectors.size();
   root_frames.nvec = nvec;
   const std::size_t stride = nvec * s2;
   ws.pool.assign(stride, 0.0);
