@@ -152,10 +152,10 @@ std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span
   }
   delta = next_up(delta * (1 + 1e-12));
   if (!(delta < kInf)) return std::nullopt;
-  double eigenvectors[9];
+  const RatioBounds ratio = constant_ratio_bounds(space, w, delta);
   QualityBounds out;
-  out.lower = sqrt_down(constant_ratio_lower(space, w, delta, eigenvectors));
-  out.upper = sqrt_up(corner_ratio_upper_at(space, w, delta, space.w_basis().vertex_indices()[0], eigenvectors));
+  out.lower = sqrt_down(ratio.lower);
+  out.upper = sqrt_up(ratio.upper);
   out.tolerance_met = out.upper - out.lower <= tol;
   if (!out.tolerance_met) return std::nullopt;
   return out;
@@ -218,7 +218,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // values agree to 1e-9 relative. Then one corner's upper bound serves for all (they
   // differ by no more than that; the others cost an eigen solve each, a quarter of mu's
   // time on tets_h0.8_o2), and the closed form of mu_constant.hpp settles the element
-  // without products when the gap is met; its eigenvectors serve the corner's bound too.
+  // without products when the gap is met, its upper bound included.
   double delta = 0;
   bool constant = false;
   if (mu_constant_path_enabled()) {
@@ -235,9 +235,9 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   }
   double r_upper = 1;
   if (constant) {
-    double eigenvectors[9];
-    out.lower = sqrt_down(constant_ratio_lower(space, pool.data(), delta, eigenvectors));
-    r_upper = corner_ratio_upper_at(space, pool.data(), err0, corner, eigenvectors);
+    const RatioBounds ratio = constant_ratio_bounds(space, pool.data(), delta);
+    out.lower = sqrt_down(ratio.lower);
+    r_upper = ratio.upper;
     out.upper = sqrt_up(r_upper);
     if (out.upper - out.lower <= options.abs_tol) {
       out.tolerance_met = true;

@@ -1,4 +1,4 @@
-// The closed form of mu for constant W (src/analysis/mu_constant.hpp) against Eigen's SVD
+// The closed forms of mu for constant W (src/analysis/mu_constant.hpp) against Eigen's SVD
 // (the exact singular values of affine elements and of sampled matrices of the box) and
 // against the general path of mu_bounds on thousands of random affine elements.
 #include <gtest/gtest.h>
@@ -49,7 +49,12 @@ TEST(MuConstant, RatioBoundEnclosesSvdOfEveryMatrixOfTheBox) {
       const double delta = trial % 2 == 0 ? 0.0 : 1e-6;
       const auto ctrl = constant_controls(space, w);
       const double lo = constant_ratio_lower(space, ctrl.data(), delta);
+      const RatioBounds both = constant_ratio_bounds(space, ctrl.data(), delta);
       const double exact = svd_ratio(w);
+      // The eigenvector-free bounds: around the exact ratio, and as tight as the above.
+      ASSERT_LE(both.lower, exact * exact * (1 + 1e-14)) << "trial " << trial;
+      ASSERT_GE(both.upper, exact * exact * (1 - 1e-14)) << "trial " << trial;
+      if (exact > 1e-3) EXPECT_LE(both.upper - both.lower, 1e-7 * exact * exact + 1e-11 + 200 * delta) << "trial " << trial;
       ASSERT_LE(std::sqrt(lo), exact * (1 + 1e-14)) << "trial " << trial;
       // Tight: the closed form loses only rounding (relative, amplified near degeneracy)
       // and delta.
@@ -59,7 +64,10 @@ TEST(MuConstant, RatioBoundEnclosesSvdOfEveryMatrixOfTheBox) {
         Eigen::MatrixXd p = w;
         for (int c = 0; c < 3; ++c)
           for (int j = 0; j < dim; ++j) p(c, j) += delta * (s < 4 ? (u(rng) > 0 ? 1.0 : -1.0) : u(rng));
-        ASSERT_LE(lo, svd_ratio(p) * svd_ratio(p) * (1 + 1e-14)) << "trial " << trial;
+        const double r = svd_ratio(p) * svd_ratio(p);
+        ASSERT_LE(lo, r * (1 + 1e-14)) << "trial " << trial;
+        ASSERT_LE(both.lower, r * (1 + 1e-14)) << "trial " << trial;
+        ASSERT_GE(both.upper, r * (1 - 1e-14)) << "trial " << trial;
       }
     }
   }
