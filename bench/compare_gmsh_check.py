@@ -2,7 +2,8 @@
 """Side by side: `quadval check` (certified Jacobian bounds, validity) and Gmsh 4.8.4's
 AnalyseMeshQuality plugin (Jacobian only, via ../shared/data/tools/gmsh_analyse.py) on the
 same files. Prints, per mesh: elements, invalid counts of both, the analysis time of each
-(median of --repeat runs, after --warmup untimed runs of each tool; quadval: its own timer
+(median of --repeat runs, the two tools alternating so that both meet the same machine
+load, after --warmup untimed runs of each tool; quadval: its own timer
 around the analysis, read from its summary line; Gmsh: the plugin's wall time around
 gmsh.plugin.run), elements per second, the ratio,
 and each process's peak memory.
@@ -104,21 +105,19 @@ def main():
             for _ in range(a.warmup):
                 run_measured([a.quadval, "check", m, "--threads", str(a.threads), "--worst", "0"])
                 run_measured([sys.executable, tool, m, "--measures", "J", "--json", gjson, "--quiet"])
-            runs = []
-            for _ in range(a.repeat):
+            runs, gruns = [], []
+            for _ in range(a.repeat):  # alternating, so that both tools see the same machine
                 rc, out, mem_q = run_measured([a.quadval, "check", m, "--threads", str(a.threads), "--worst", "0"])
                 if rc not in (0, 1):
                     break
                 runs.append((summary_seconds(out), (summary_count(out, "invalid"), summary_elements(out), mem_q)))
+                _, _, mem_g = run_measured([sys.executable, tool, m, "--measures", "J", "--json", gjson, "--quiet"])
+                g = json.load(open(gjson))
+                gruns.append((g["t_plugin_run_s"], (g["n_invalid_ratio_le_0"], mem_g)))
             if len(runs) < a.repeat:
                 print("%-36s quadval failed (exit %d)" % (os.path.basename(m), rc))
                 continue
             tq, (inv_q, n, mem_q) = median_run(runs)
-            gruns = []
-            for _ in range(a.repeat):
-                rc, _, mem_g = run_measured([sys.executable, tool, m, "--measures", "J", "--json", gjson, "--quiet"])
-                g = json.load(open(gjson))
-                gruns.append((g["t_plugin_run_s"], (g["n_invalid_ratio_le_0"], mem_g)))
             tg, (inv_g, mem_g) = median_run(gruns)
             print("%-36s %9d %8d %8d %10.3g %10.3g %12.3g %12.3g %8.1f %9.0f %9.0f" % (
                 os.path.basename(m)[:36], n, inv_q, inv_g, tq, tg, n / tq, n / tg, tg / tq, mem_q, mem_g))
@@ -161,12 +160,16 @@ def quality(a, meshes, tool):
         for m in meshes:
             for measure, gmeasures, qkey, gkey in pairs:
                 cmd = [a.quadval, "check", m, "--measure", measure, "--tol", str(a.tol), "--threads", str(a.threads)]
-                runs = []
-                for _ in range(a.repeat):  # timed without per-element output (see the top)
+                gjson = os.path.join(tmp, "g.json")
+                runs, gruns = [], []
+                for _ in range(a.repeat):  # timed without per-element output (see the top); alternating
                     rc, out, _ = run_measured(cmd + ["--worst", "0"])
                     if rc not in (0, 1):
                         break
                     runs.append((summary_seconds(out), summary_elements(out)))
+                    run_measured([sys.executable, tool, m, "--measures", gmeasures, "--json", gjson, "--quiet"])
+                    g = json.load(open(gjson))
+                    gruns.append((g["t_plugin_run_s"], g.get(gkey, float("nan"))))
                 if len(runs) < a.repeat:
                     print("%-36s quadval --measure %s failed (exit %d)" % (os.path.basename(m), measure, rc))
                     continue
@@ -177,12 +180,6 @@ def quality(a, meshes, tool):
                 key = "mu" if qkey == "mu" else "sj"
                 lows = [e[key]["lower"] for e in json.load(open(qjson))["elements"] if key in e]
                 worst_q = min(lows) if lows else float("nan")
-                gjson = os.path.join(tmp, "g.json")
-                gruns = []
-                for _ in range(a.repeat):
-                    run_measured([sys.executable, tool, m, "--measures", gmeasures, "--json", gjson, "--quiet"])
-                    g = json.load(open(gjson))
-                    gruns.append((g["t_plugin_run_s"], g.get(gkey, float("nan"))))
                 tg, worst_g = median_run(gruns)
                 print("%-36s %-16s %9d %10.3g %10.3g %12.3g %12.3g %8.1f %11.4g %11.4g" % (
                     os.path.basename(m)[:36], "%s/%s" % ("mu" if qkey == "mu" else "sj", gmeasures[1:]), n, tq, tg,
