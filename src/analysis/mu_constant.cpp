@@ -1,8 +1,8 @@
 // Closed-form bounds of mu for constant W (see mu_constant.hpp for the method).
 #include "analysis/mu_constant.hpp"
-#include "analysis/mu_w_matrix.hpp"
 #include "analysis/mu_control_bound.hpp"
 #include "analysis/mu_metric.hpp"
+#include "analysis/mu_w_matrix.hpp"
 
 #include <Eigen/Dense>
 
