@@ -42,7 +42,9 @@ double up(double x) { return next_up(x); }
 // (warped_pyramid_o2: 163 elements settled by one split). A root within 4 tolerances
 // instead of 2 (sj on one thread, fastest of 7): warped_pyramid_o2 98 -> 91 ms, whose full
 // bounds work in (6r + 1)^3 coefficients, but tets_h0.8_o2 12 -> 15 ms, and the quadrangles
-// of quad_h0.4_o2 and mixed_h0.6_o2 5-15% slower.
+// of quad_h0.4_o2 and mixed_h0.6_o2 5-15% slower. No quotient stage at all for quadrangles
+// and hexahedra: hex_box 10% faster, but mixed_h0.6_o2 20% and warped_hexahedron_o2 25%
+// slower.
 constexpr int kQuotientSplits = 4;
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one

@@ -434,6 +434,9 @@ void BernsteinProduct::accumulate_grid(const double* f, const double* g, double 
   }
 }
 
+// (Two interleaved partial sums per row, to halve the chain of dependent additions, were
+// no faster: folded quartic triangles' scaled Jacobian 9.0-9.1 vs 9.1-9.3 us per element,
+// alternating runs. The loop is bound by its indexed loads.)
 // The entry kernel for N terms in one walk over the pairs: per pair, the N scaled products
 // summed (N + 1 roundings deep), times the pair's weight, then the row's sum. Within
 // rounding(N): with the weight's own rounding, N + 3 per pair plus the row's max_terms
