@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analysis/outward_rounding.hpp"
+#include "bezier/multi_index_table.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -33,10 +34,11 @@ struct FactorPoint {
 std::vector<FactorPoint> factor_points(const BernsteinSimplex& f) {
   const int d = f.dim(), n = f.degree();
   const auto alphas = f.multi_indices();
+  const MultiIndexTable table({alphas.begin(), alphas.end()}, n);
   const auto index_of = [&](const std::array<int, 4>& a) {
-    const auto it = std::find(alphas.begin(), alphas.end(), a);
-    QV_ASSERT(it != alphas.end(), "multi-index outside the factor");
-    return static_cast<int>(it - alphas.begin());
+    const int i = table(a);
+    QV_ASSERT(i >= 0, "multi-index outside the factor");
+    return i;
   };
   std::vector<FactorPoint> out;
   for (int a = 0; a <= d; ++a) {
