@@ -95,32 +95,6 @@ double ratio_lower(const Eigen::Matrix<double, 3, D>& w, double delta, double* e
   return std::clamp(next_down(l_min / l_max), 0.0, 1.0);
 }
 
-// The entries of M_0 = W_0^T W_0 (order m00, m11, (m22,) m01, (m02, m12)) and a bound on
-// |M - M_0| for every W within delta of W_0 entrywise: M - M_0 = W_0^T E + E^T W_0 +
-// E^T E, so |(M - M_0)_ij| <= delta sum_c (|w_ci| + |w_cj|) + 3 delta^2, plus the rounding
-// of M_0's 3-term sums (gamma_3 sum_c |w_ci w_cj|); all enlarged by gamma_16 for the
-// bound's own rounding.
-template <int D>
-double metric_entries(const Eigen::Matrix<double, 3, D>& w, double delta, double* m) {
-  constexpr int kPairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-  constexpr int kOrder2[3] = {0, 1, 3};  // the 2 x 2 entries among kPairs
-  const double g = margin();
-  double err = 0;
-  for (int e = 0; e < D * (D + 1) / 2; ++e) {
-    const int pair = D == 2 ? kOrder2[e] : e;
-    const int i = kPairs[pair][0], j = kPairs[pair][1];
-    double s = 0, mag = 0, cols = 0;
-    for (int c = 0; c < 3; ++c) {
-      s += w(c, i) * w(c, j);
-      mag += std::abs(w(c, i) * w(c, j));
-      cols += std::abs(w(c, i)) + std::abs(w(c, j));
-    }
-    m[e] = s;
-    err = std::max(err, (delta * cols + 3 * delta * delta + g * mag) * (1 + g));
-  }
-  return next_up(err);
-}
-
 // An approximate unit eigenvector of the symmetric 3 x 3 matrix m for the approximate
 // eigenvalue lambda (accuracy only: corner_ratio_upper_at's Rayleigh quotients are true
 // bounds for any vector): the largest cross product of two rows of m - lambda I, which
@@ -162,26 +136,21 @@ double constant_ratio_lower(const MuSpace& space, const double* w, double delta,
 }
 
 RatioBounds constant_ratio_bounds(const MuSpace& space, const double* w, double delta) {
+  // M_0 and the distance of every W^T W of the box from it (corner_metric, at W_0).
   const int corner = space.w_basis().vertex_indices()[0];
-  double m[6];
+  const CornerMetric cm = corner_metric(corner_w(space, w, 0), space.dim(), delta);
+  const double* m = cm.m.data();
   if (space.dim() == 2) {
-    const Eigen::Matrix<double, 3, 2> w0 = w_at<2>(space, w, 0);
-    if (w0.allFinite()) {
-      const double err = metric_entries<2>(w0, delta, m);
-      const EigenEnclosure e = symmetric_eigen_enclosure<2>(m, err);
-      if (e.min_lo > 0 && std::isfinite(e.max_hi)) return {e.ratio_lower(), e.ratio_upper()};
-    }
+    const EigenEnclosure e = symmetric_eigen_enclosure<2>(m, cm.err);
+    if (e.min_lo > 0 && std::isfinite(e.max_hi)) return {e.ratio_lower(), e.ratio_upper()};
   } else {
-    const Eigen::Matrix<double, 3, 3> w0 = w_at<3>(space, w, 0);
-    if (w0.allFinite()) {
-      const double err = metric_entries<3>(w0, delta, m);
-      double lo = 0, hi = 0;
-      double vectors[9] = {};  // columns 0 and 2: the least and the largest eigenvalue's
-      if (extreme_eigen_bounds3(m, err, lo, hi) && lo > 0 && eigenvector3(m, lo, vectors) &&
-          eigenvector3(m, hi, vectors + 6))
-        return {std::clamp(next_down(lo / hi), 0.0, 1.0), corner_ratio_upper_at(space, w, delta, corner, vectors)};
-    }
+    double lo = 0, hi = 0;
+    double vectors[9] = {};  // columns 0 and 2: the least and the largest eigenvalue's
+    if (extreme_eigen_bounds3(m, cm.err, lo, hi) && lo > 0 && eigenvector3(m, lo, vectors) &&
+        eigenvector3(m, hi, vectors + 6))
+      return {std::clamp(next_down(lo / hi), 0.0, 1.0), corner_ratio_upper_at(space, w, delta, corner, vectors)};
   }
+  // Not finite, or a certification failed.
   double eigenvectors[9];
   const double lower = constant_ratio_lower(space, w, delta, eigenvectors);
   return {lower, corner_ratio_upper_at(space, w, delta, corner, eigenvectors)};

@@ -35,8 +35,8 @@ double constant_w_radius(const MuSpace& space, const double* w, double err);
 double constant_ratio_lower(const MuSpace& space, const double* w, double delta, double* eigenvectors = nullptr);
 
 /// Certified bounds lower <= R(W) <= upper for every W of the same box, without Eigen's
-/// trigonometric eigen solve: the entries of M_0 = W_0^T W_0 are enclosed (|M - M_0| <=
-/// delta times W_0's column sums, plus 3 delta^2 and M_0's rounding); 2D: the closed-form
+/// trigonometric eigen solve: the entries of M_0 = W_0^T W_0 are enclosed for the whole box
+/// (corner_metric of mu_metric.hpp); 2D: the closed-form
 /// enclosure of a 2 x 2 matrix; 3D: extreme_eigen_bounds3 (mu_control_bound.hpp) for the
 /// lower bound, and for the upper the Rayleigh quotients (corner_ratio_upper_at) of
 /// eigenvectors taken as cross products of rows of M_0 - lambda I. Where these fail

@@ -496,9 +496,6 @@ double corner_upper(const Eigen::Matrix<double, 3, D>& wm, double err, const dou
 
 }  // namespace
 
-namespace {
-
-// W at corner k of the subdomain (entries j * 3 + c; zero beyond dim).
 std::array<double, 9> corner_w(const MuSpace& space, const double* w, int k) {
   const auto ws = static_cast<std::size_t>(space.w_size());
   std::array<double, 9> out{};
@@ -508,22 +505,10 @@ std::array<double, 9> corner_w(const MuSpace& space, const double* w, int k) {
   return out;
 }
 
-}  // namespace
-
 void remember_corners(const MuSpace& space, const double* w, std::vector<std::array<double, 9>>& seen) {
   for (const int k : space.w_basis().vertex_indices()) seen.push_back(corner_w(space, w, k));
 }
 
-namespace {
-
-// The metric W^T W of a corner's W (corner_w's layout) in control_ratio_lower's entry
-// order, and a bound on its distance to the exact metric when every entry of W is within
-// err: |W'^T W' - W^T W|_ij <= sum_c (|w_ci| + |w_cj| + err) err, plus gamma_4 of
-// sum_c |w_ci w_cj| for the computed sums (and 1e-12 relative for the bound's own rounding).
-struct CornerMetric {
-  std::array<double, 6> m{};
-  double err = 0;
-};
 CornerMetric corner_metric(const std::array<double, 9>& w, int dim, double err) {
   static constexpr int kPairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
   static constexpr int kPairs2[3][2] = {{0, 0}, {1, 1}, {0, 1}};
@@ -544,6 +529,8 @@ CornerMetric corner_metric(const std::array<double, 9>& w, int dim, double err) 
   }
   return out;
 }
+
+namespace {
 
 // A cheap estimate of R at a corner (not certified: it only orders the corners, so that
 // the least bound is usually found first): det M / (tr M / dim)^dim, 1 for isotropic M.

@@ -126,6 +126,18 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err,
 ///                      them; any vectors give a true bound, only its tightness depends on them
 double corner_ratio_upper_at(const MuSpace& space, const double* w, double err, int k,
                              const double* eigenvectors = nullptr);
+/// W at control point k (a corner when k is a vertex index): entries j * 3 + c for column
+/// j and coordinate c, zero beyond dim.
+std::array<double, 9> corner_w(const MuSpace& space, const double* w, int k);
+/// The metric W^T W of such a W in control_ratio_lower's entry order (m00, m11, (m22,) m01,
+/// (m02, m12)), and a bound on its distance to the exact metric of every W within err
+/// entrywise: |W'^T W' - W^T W|_ij <= sum_c (|w_ci| + |w_cj| + err) err, plus gamma_4 of
+/// sum_c |w_ci w_cj| for the computed sums (and 1e-12 relative for the bound's own rounding).
+struct CornerMetric {
+  std::array<double, 6> m{};
+  double err = 0;
+};
+CornerMetric corner_metric(const std::array<double, 9>& w, int dim, double err);
 /// Appends the W values of the subdomain's corners to `seen` (corner_ratio_upper's layout).
 void remember_corners(const MuSpace& space, const double* w, std::vector<std::array<double, 9>>& seen);
 
