@@ -50,6 +50,16 @@ struct DemoCliOptions {
   bool list = false, verbose = false, quiet = false;
 };
 
+// "rectangle, square-hole, ...": the demos' names, for messages and --help.
+std::string demo_names() {
+  std::string names;
+  for (const Demo& d : kDemos) {
+    if (!names.empty()) names += ", ";
+    names += d.name;
+  }
+  return names;
+}
+
 const Demo* find_demo(const std::string& name) {
   for (const Demo& d : kDemos)
     if (name == d.name) return &d;
@@ -64,8 +74,7 @@ int run(const DemoCliOptions& o) {
   }
   const Demo* demo = find_demo(o.name);
   if (!demo) {
-    std::string names;
-    for (const Demo& d : kDemos) names += (names.empty() ? "" : ", ") + std::string(d.name);
+    const std::string names = demo_names();
     throw InputError::in_file("quadval demo",
                               fmt::format("no demo called '{}'; the demos are {}", o.name, names));
   }
@@ -110,8 +119,7 @@ int run(const DemoCliOptions&) { return no_gmsh_in_this_build("demo"); }
 
 void add_demo_command(CLI::App& app, int& exit_code) {
   auto o = std::make_shared<DemoCliOptions>();
-  std::string names;
-  for (const Demo& d : kDemos) names += (names.empty() ? "" : ", ") + std::string(d.name);
+  const std::string names = demo_names();
   auto* cmd = app.add_subcommand(
       "demo", "Run a built-in example end to end (no input file): triangles, quads, statistics, "
               "meshes, SVG pictures");

@@ -100,8 +100,10 @@ void check_manifold(const std::string& source, const TriangleSurface& s,
   if (topo.nonmanifold_edges.empty()) return;
   const std::uint32_t e = topo.nonmanifold_edges.front();
   std::string tags;
-  for (std::uint32_t i = topo.edge_triangle_offsets[e]; i < topo.edge_triangle_offsets[e + 1]; ++i)
-    tags += (tags.empty() ? "" : " ") + std::to_string(s.triangle_tags[topo.edge_triangles[i]]);
+  for (std::uint32_t i = topo.edge_triangle_offsets[e]; i < topo.edge_triangle_offsets[e + 1]; ++i) {
+    if (!tags.empty()) tags += ' ';
+    tags += std::to_string(s.triangle_tags[topo.edge_triangles[i]]);
+  }
   throw InputError::in_element(
       source, s.triangle_tags[topo.edge_triangles[topo.edge_triangle_offsets[e] + 2]],
       fmt::format("non-manifold edge: nodes {} and {} are shared by {} triangles ({}); "

@@ -100,7 +100,7 @@ class QualityCli : public testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
-  const std::string data_ = std::string(QUADVAL_SHARED_DIR) + "/data/curved/";
+  const std::string data_ = QUADVAL_SHARED_DIR "/data/curved/";
 };
 
 TEST_F(QualityCli, EquilateralTrianglesHaveScaledJacobianOne) {
