@@ -13,9 +13,25 @@
 // so with coefficients within err of the exact ones the value is within err plus the
 // rounding of the sum, bounded by gamma(2 terms + 8) * sum w |c| (covering the weights'
 // own roundings, a few u relative).
+#include <vector>
+
 #include "quadval/bezier_basis.hpp"
 
 namespace quadval {
+
+/// The probe points of a basis as sparse rows: point p has the terms [first[p], first[p + 1])
+/// of (index, weight); gamma bounds the rounding of the longest row (see above).
+struct MidpointProbeTable {
+  std::vector<int> first{0};
+  std::vector<int> index;
+  std::vector<double> weight;
+  double gamma = 0;
+};
+
+/// Builds the table of a basis. midpoint_probe_upper takes the common bases' tables from
+/// those generated at build time (product_tables.hpp), which tools/gen_product_tables.cpp
+/// makes with this function.
+MidpointProbeTable build_midpoint_probe_table(const BezierBasis& basis);
 
 /// A certified upper bound of min J over the probe points (+inf when the basis has none):
 /// J <= 0 is proven at one of them when it is <= 0.

@@ -7,7 +7,8 @@
 // us of a 160 us check of quad_h0.4_o2). Internal to src/analysis.
 //
 // The same for the derivative maps of mu's space (MuSpace, mu_space.hpp): their exact set-up
-// was half of a first `check --measure mu` of tri_h0.4_o4 (about 1 ms).
+// was half of a first `check --measure mu` of tri_h0.4_o4 (about 1 ms); and for the midpoint
+// probe's tables (midpoint_probe.hpp), about 13 us of a 155 us check of quad_h0.4_o2.
 //
 // tools/gen_product_tables.cpp builds each type's JacobianProduct (and MuSpace) in exact
 // arithmetic (TableSource::exact), the same code path as any other type, and writes their tables as
@@ -16,6 +17,8 @@
 // product_tables_none.cpp instead. tests/analysis/product_tables_test.cpp checks that the
 // generated tables equal the exactly built ones bit for bit.
 #include <span>
+
+#include "quadval/element_type.hpp"
 
 namespace quadval {
 
@@ -46,6 +49,22 @@ struct MuTableView {
 
 /// The generated MuSpace tables of a Gmsh type id, or nullptr when none were generated.
 const MuTableView* generated_mu_tables(int gmsh_id) noexcept;
+
+/// The midpoint probe's table (MidpointProbeTable, midpoint_probe.hpp) of the Jacobian
+/// basis of one (family, order) as views of static arrays.
+struct ProbeTableView {
+  ElementFamily family = ElementFamily::point;
+  int order = 0;
+  std::span<const int> first, index;
+  std::span<const double> weight;
+  double gamma = 0;
+};
+
+/// The generated probe table of the basis bezier_basis(family, order), or nullptr.
+const ProbeTableView* generated_probe_table(ElementFamily family, int order) noexcept;
+
+/// All generated probe tables (for tests).
+std::span<const ProbeTableView> generated_probe_tables() noexcept;
 
 /// The ids of all generated types (for tests).
 std::span<const int> generated_product_table_ids() noexcept;

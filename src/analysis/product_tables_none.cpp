@@ -10,4 +10,8 @@ std::span<const int> generated_product_table_ids() noexcept { return {}; }
 
 const MuTableView* generated_mu_tables(int) noexcept { return nullptr; }
 
+const ProbeTableView* generated_probe_table(ElementFamily, int) noexcept { return nullptr; }
+
+std::span<const ProbeTableView> generated_probe_tables() noexcept { return {}; }
+
 }  // namespace quadval

@@ -1,6 +1,7 @@
 // The build-time product tables (src/analysis/product_tables.hpp): bit for bit the tables
 // that exact arithmetic gives at run time, used by jacobian_space for the common types, and
-// the exact data the generated path builds lazily agrees with them.
+// the exact data the generated path builds lazily agrees with them; the same for the
+// midpoint probe's tables.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -12,6 +13,7 @@
 
 #include "analysis/jacobian_product.hpp"
 #include "analysis/jacobian_space.hpp"
+#include "analysis/midpoint_probe.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/product_tables.hpp"
 #include "jacobian_test_util.hpp"
@@ -104,6 +106,25 @@ TEST(ProductTables, GeneratedMuTablesEqualExactlyBuiltBitForBit) {
     }
   }
   EXPECT_GE(count, 30);
+}
+
+TEST(ProductTables, GeneratedProbeTablesEqualBuiltOnesBitForBit) {
+  // One per basis of a generated type, each the table build_midpoint_probe_table makes.
+  for (int id : generated_product_table_ids()) {
+    const ElementType& type = *find_element_type(id);
+    EXPECT_NE(generated_probe_table(type.family, type.order), nullptr) << type.name;
+  }
+  const auto tables = generated_probe_tables();
+  ASSERT_GE(tables.size(), 30u);
+  for (const ProbeTableView& view : tables) {
+    SCOPED_TRACE(std::string(family_name(view.family)) + " order " + std::to_string(view.order));
+    EXPECT_EQ(generated_probe_table(view.family, view.order), &view);  // one per (family, order)
+    const MidpointProbeTable built = build_midpoint_probe_table(bezier_basis(view.family, view.order));
+    EXPECT_EQ(std::vector<int>(view.first.begin(), view.first.end()), built.first);
+    EXPECT_EQ(std::vector<int>(view.index.begin(), view.index.end()), built.index);
+    expect_same_bits(view.weight, built.weight, "weights");
+    expect_same_bits(std::span(&view.gamma, 1), std::span(&built.gamma, 1), "gamma");
+  }
 }
 
 TEST(ProductTables, CommonTypesAreGenerated) {
