@@ -179,7 +179,10 @@ double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& b
 
 // Lane blocks gathered from the mesh a node at a time, as lane_margins asks for them (it
 // stops at the first node that shows every lane curved). A tail block repeats its last
-// element.
+// element. Measured and not adopted: AVX-512 hardware gathers (the eight lanes' node ids in
+// one, then one per axis) took 62 ns per element of tri_h0.4_o4 against 39 for these loads
+// (gathers are slow on this CPU); loading through a stack array gained nothing with
+// link-time optimisation (25.5 ns either way).
 void StraightSidedMargin::margins(const double* coords, const NodeIndex* conn, std::size_t count,
                                   double* out) const noexcept {
   if (kind_ == LinearKind::none) {
