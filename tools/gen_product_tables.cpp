@@ -4,7 +4,8 @@
 //
 // For every common element type, builds its JacobianProduct in exact rational arithmetic
 // (TableSource::exact: the code path of every other type), its MuSpace derivative maps and
-// its basis's midpoint-probe table (midpoint_probe.hpp), and writes the rounded tables as
+// its basis's midpoint-probe table (midpoint_probe.hpp) and its factors' bisection lines
+// (bernstein_bisection.hpp), and writes the rounded tables as
 // hexadecimal float literals, which the compiler reads back to the same doubles bit for
 // bit, and the kernel's index tables as integers. CMake runs it (add_custom_command) and compiles OUT.cpp into quadval_product_tables.
 // Linked with src/analysis/product_tables_none.cpp, so it never reads tables of its own.
@@ -21,6 +22,7 @@
 #include "analysis/jacobian_product.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "analysis/midpoint_probe.hpp"
+#include "bezier/bernstein_bisection.hpp"
 #include "analysis/mu_space.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
@@ -92,6 +94,8 @@ int main(int argc, char** argv) {
   }
   std::ostringstream arrays, entries, ids, mu_entries, probe_entries;
   std::vector<std::pair<quadval::ElementFamily, int>> probe_bases;  // (family, order) done
+  std::ostringstream line_entries;
+  std::vector<std::pair<int, int>> line_factors;  // (dim, degree) done
   std::vector<int> slot_of_id;  // 1 + index into kTables, 0 for none
   std::vector<int> mu_slot_of_id;  // 1 + index into kMuTables, 0 for none
   int count = 0, mu_count = 0;
@@ -142,6 +146,24 @@ int main(int argc, char** argv) {
                     << ", " << index << ", " << weight << ", " << hex(probe.gamma) << "},  // "
                     << quadval::family_name(t->family) << " " << t->order << "\n";
     }
+    // The bisection's edge lines of each factor of this type's basis, once per (dim, degree).
+    for (const quadval::FactorDegree& fd : quadval::jacobian_factor_degrees(t->family, t->order)) {
+      if (std::find(line_factors.begin(), line_factors.end(), std::pair{fd.dim, fd.degree}) != line_factors.end())
+        continue;
+      line_factors.emplace_back(fd.dim, fd.degree);
+      const quadval::FactorEdgeLines lines = quadval::build_factor_edge_lines(fd.dim, fd.degree);
+      const std::string q = std::string("f").append(std::to_string(fd.dim)).append("_").append(std::to_string(fd.degree));
+      std::string first[16], index[16];
+      for (std::size_t k = 0; k < 16; ++k) {
+        first[k] = array(arrays, q + "_first" + std::to_string(k), lines.first[k]);
+        index[k] = array(arrays, q + "_index" + std::to_string(k), lines.index[k]);
+      }
+      line_entries << "    {" << fd.dim << ", " << fd.degree << ",\n     {{";  // std::array: {{...}}
+      for (std::size_t k = 0; k < 16; ++k) line_entries << (k ? ", " : "") << first[k];
+      line_entries << "}},\n     {{";
+      for (std::size_t k = 0; k < 16; ++k) line_entries << (k ? ", " : "") << index[k];
+      line_entries << "}}},\n";
+    }
     ids << (count % 12 == 0 ? "\n    " : " ") << id << ",";
     slot_of_id.resize(static_cast<std::size_t>(id) + 1, 0);
     slot_of_id.back() = ++count;
@@ -165,7 +187,7 @@ int main(int argc, char** argv) {
          "// The Bernstein-product tables (with MuSpace derivative maps and midpoint-probe tables) of "
       << count
       << " element types (src/analysis/product_tables.hpp).\n"
-         "#include \"analysis/product_tables.hpp\"\n\n"
+         "#include \"analysis/product_tables.hpp\"\n#include \"bezier/bernstein_bisection.hpp\"\n\n"
          "namespace quadval {\nnamespace {\n\n"
       << arrays.str() << "\nconst ProductTableView kTables[] = {\n"
       << entries.str() << "};\n\nconst int kIds[] = {" << ids.str() << "\n};\n\n"
@@ -177,6 +199,7 @@ int main(int argc, char** argv) {
   for (std::size_t id = 0; id < mu_slot_of_id.size(); ++id)
     out << (id % 20 == 0 ? "\n    " : " ") << mu_slot_of_id[id] << ",";
   out << "\n};\n\nconst ProbeTableView kProbeTables[] = {\n" << probe_entries.str() << "};\n\n"
+      << "const FactorEdgeLinesView kEdgeLines[] = {\n" << line_entries.str() << "};\n\n"
       << "}  // namespace\n\n"
       << "const MuTableView* generated_mu_tables(int gmsh_id) noexcept {\n"
          "  if (gmsh_id < 0 || static_cast<std::size_t>(gmsh_id) >= sizeof kMuSlot || kMuSlot[gmsh_id] == 0) return nullptr;\n"
@@ -190,6 +213,11 @@ int main(int argc, char** argv) {
          "    if (t.family == family && t.order == order) return &t;\n"
          "  return nullptr;\n}\n\n"
          "std::span<const ProbeTableView> generated_probe_tables() noexcept { return kProbeTables; }\n\n"
+         "const FactorEdgeLinesView* generated_factor_edge_lines(int dim, int degree) noexcept {\n"
+         "  for (const FactorEdgeLinesView& t : kEdgeLines)\n"
+         "    if (t.dim == dim && t.degree == degree) return &t;\n"
+         "  return nullptr;\n}\n\n"
+         "std::span<const FactorEdgeLinesView> generated_factor_edge_lines() noexcept { return kEdgeLines; }\n\n"
          "}  // namespace quadval\n";
   // Write-then-rename: an interrupted build never leaves a truncated table file.
   const std::string path = argv[1], tmp = path + ".tmp";
@@ -205,7 +233,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "gen_product_tables: cannot rename to %s\n", path.c_str());
     return 1;
   }
-  std::printf("gen_product_tables: %d types (%d with mu tables), %zu probe tables -> %s\n", count, mu_count,
-              probe_bases.size(), path.c_str());
+  std::printf("gen_product_tables: %d types (%d with mu tables), %zu probe tables, %zu factors' lines -> %s\n",
+              count, mu_count, probe_bases.size(), line_factors.size(), path.c_str());
   return 0;
 }

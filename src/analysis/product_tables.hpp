@@ -7,8 +7,10 @@
 // us of a 160 us check of quad_h0.4_o2). Internal to src/analysis.
 //
 // The same for the derivative maps of mu's space (MuSpace, mu_space.hpp): their exact set-up
-// was half of a first `check --measure mu` of tri_h0.4_o4 (about 1 ms); and for the midpoint
-// probe's tables (midpoint_probe.hpp), about 13 us of a 155 us check of quad_h0.4_o2.
+// was half of a first `check --measure mu` of tri_h0.4_o4 (about 1 ms); for the midpoint
+// probe's tables (midpoint_probe.hpp), about 13 us of a 155 us check of quad_h0.4_o2; and for
+// the bisection's edge lines of the bases' factors (declared in bernstein_bisection.hpp, as
+// the bezier layer reads them), about 15 us more of that check.
 //
 // tools/gen_product_tables.cpp builds each type's JacobianProduct (and MuSpace) in exact
 // arithmetic (TableSource::exact), the same code path as any other type, and writes their tables as

@@ -25,6 +25,34 @@ constexpr double kHalfDenormMin = 0x1p-1074;  // bound on the error of a subnorm
 
 }  // namespace
 
+FactorEdgeLines build_factor_edge_lines(int dim, int degree) {
+  const std::vector<std::array<int, 4>> alphas = simplex_multi_indices(dim, degree);
+  // (A std::map here was most of the first subdivision's cost: 20 us of a 230 us check
+  // of tri_h0.4_o4.)
+  const MultiIndexTable local_of(alphas, degree);
+  FactorEdgeLines out;
+  for (int a = 0; a <= dim; ++a)
+    for (int b = 0; b <= dim; ++b) {
+      if (a == b) continue;
+      const auto k = static_cast<std::size_t>(a * 4 + b);
+      std::vector<int>& first = out.first[k];
+      std::vector<int>& index = out.index[k];
+      first.push_back(0);
+      for (const auto& alpha : alphas) {
+        if (alpha[static_cast<std::size_t>(b)] != 0) continue;
+        std::array<int, 4> beta = alpha;
+        const int m = alpha[static_cast<std::size_t>(a)];
+        for (int i = 0; i <= m; ++i) {
+          beta[static_cast<std::size_t>(a)] = m - i;
+          beta[static_cast<std::size_t>(b)] = i;
+          index.push_back(local_of(beta));
+        }
+        first.push_back(static_cast<int>(index.size()));
+      }
+    }
+  return out;
+}
+
 BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
     : factors_(std::move(factors)) {
   QV_ASSERT(!factors_.empty() && factors_.size() <= 3, factors_.size() << " factors");
@@ -47,27 +75,12 @@ BernsteinBisection::BernsteinBisection(std::vector<FactorDegree> factors)
       if ((g / stride_[f]) % sizes[f] == 0) bases_[f].push_back(g);
     const int d = factors_[f].dim;
     const int n = factors_[f].degree;
-    // (A std::map here was most of the first subdivision's cost: 20 us of a 230 us check
-    // of tri_h0.4_o4.)
-    const MultiIndexTable local_of(alphas[f], n);
-    for (int a = 0; a <= d; ++a)
-      for (int b = 0; b <= d; ++b) {
-        if (a == b) continue;
-        // One line per multi-index with alpha_b = 0, walking alpha_a -> alpha_b.
-        EdgeLines& el = lines_[f][static_cast<std::size_t>(a * 4 + b)];
-        el.first.push_back(0);
-        for (const auto& alpha : alphas[f]) {
-          if (alpha[static_cast<std::size_t>(b)] != 0) continue;
-          std::array<int, 4> beta = alpha;
-          const int m = alpha[static_cast<std::size_t>(a)];
-          for (int i = 0; i <= m; ++i) {
-            beta[static_cast<std::size_t>(a)] = m - i;
-            beta[static_cast<std::size_t>(b)] = i;
-            el.index.push_back(local_of(beta));
-          }
-          el.first.push_back(static_cast<int>(el.index.size()));
-        }
-      }
+    if (const FactorEdgeLinesView* g = generated_factor_edge_lines(d, n)) {
+      for (std::size_t k = 0; k < 16; ++k) lines_[f][k] = {g->first[k], g->index[k]};
+    } else {
+      built_lines_[f] = build_factor_edge_lines(d, n);
+      for (std::size_t k = 0; k < 16; ++k) lines_[f][k] = {built_lines_[f].first[k], built_lines_[f].index[k]};
+    }
     // Maubach's start (tag d). Triangles: (v1, v0, v2), so that the first edge is the
     // hypotenuse. Tetrahedra: (v0, v1, v2, v3), the image of the Kuhn simplex
     // (0, e1, e1 + e2, e1 + e2 + e3) under a linear map; measured on

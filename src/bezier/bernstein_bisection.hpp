@@ -56,12 +56,35 @@ struct BisectionState {
   int step = 0;
 };
 
+/// The lines of one simplex factor (dim, degree) parallel to its edges: for the directed
+/// edge (a, b) (slot a * 4 + b, a != b, both <= dim), one line per multi-index with
+/// alpha_b = 0, its local indices walking alpha_a -> alpha_b; first holds #lines + 1
+/// offsets into index.
+struct FactorEdgeLines {
+  std::array<std::vector<int>, 16> first, index;
+};
+FactorEdgeLines build_factor_edge_lines(int dim, int degree);
+
+/// The same as views of static arrays, made at build time for the factors of the common
+/// types' Jacobian bases (src/analysis/product_tables.hpp; building them was about 15 us of
+/// a cold 155 us check of quad_h0.4_o2), or nullptr.
+struct FactorEdgeLinesView {
+  int dim = 0, degree = 0;
+  std::array<std::span<const int>, 16> first, index;
+};
+const FactorEdgeLinesView* generated_factor_edge_lines(int dim, int degree) noexcept;
+/// All of them (for tests).
+std::span<const FactorEdgeLinesView> generated_factor_edge_lines() noexcept;
+
 class BernsteinBisection {
  public:
   /// @pre 1..3 factors, dims 1..3 (total dimension <= 3), degrees >= 0; the coefficient
   ///      layout is BezierBasis's (index i_0 + s_0 (i_1 + s_1 i_2), multi-indices in
   ///      simplex_multi_indices order).
   explicit BernsteinBisection(std::vector<FactorDegree> factors);
+  // Not copied: lines_ may view built_lines_.
+  BernsteinBisection(const BernsteinBisection&) = delete;
+  BernsteinBisection& operator=(const BernsteinBisection&) = delete;
 
   int size() const noexcept { return size_; }
   int dim() const noexcept { return dim_; }
@@ -110,8 +133,8 @@ class BernsteinBisection {
 
  private:
   struct EdgeLines {  // lines of factor f parallel to edge (a, b): local indices, alpha_b = 0..m
-    std::vector<int> first;  // #lines + 1 offsets into index
-    std::vector<int> index;
+    std::span<const int> first;  // #lines + 1 offsets into index
+    std::span<const int> index;
   };
   // Bisects the `count` vectors at `in` (size_ each, contiguous) along factor f's edge
   // between slots a and b: out_keep_a has slot b replaced by the midpoint, out_keep_b slot
@@ -127,7 +150,8 @@ class BernsteinBisection {
   int dim_ = 0;
   std::array<int, 3> stride_{1, 1, 1};
   std::array<std::vector<int>, 3> bases_;  // per factor: offsets of all other factors' combinations
-  std::array<std::array<EdgeLines, 16>, 3> lines_;
+  std::array<std::array<EdgeLines, 16>, 3> lines_;  // views of generated or built_lines_
+  std::array<FactorEdgeLines, 3> built_lines_;
   std::vector<int> vertex_indices_;
   BisectionState root_;
   double rounding_relative_ = 0, rounding_absolute_ = 0;

@@ -1,7 +1,7 @@
 // The build-time product tables (src/analysis/product_tables.hpp): bit for bit the tables
 // that exact arithmetic gives at run time, used by jacobian_space for the common types, and
 // the exact data the generated path builds lazily agrees with them; the same for the
-// midpoint probe's tables.
+// midpoint probe's tables and the bisection's edge lines.
 #include <gtest/gtest.h>
 
 #include <bit>
@@ -16,6 +16,7 @@
 #include "analysis/midpoint_probe.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/product_tables.hpp"
+#include "bezier/bernstein_bisection.hpp"
 #include "jacobian_test_util.hpp"
 
 namespace quadval {
@@ -124,6 +125,26 @@ TEST(ProductTables, GeneratedProbeTablesEqualBuiltOnesBitForBit) {
     EXPECT_EQ(std::vector<int>(view.index.begin(), view.index.end()), built.index);
     expect_same_bits(view.weight, built.weight, "weights");
     expect_same_bits(std::span(&view.gamma, 1), std::span(&built.gamma, 1), "gamma");
+  }
+}
+
+TEST(ProductTables, GeneratedBisectionLinesEqualBuiltOnes) {
+  // One per factor of a generated type's basis, each what build_factor_edge_lines makes.
+  for (int id : generated_product_table_ids()) {
+    const ElementType& type = *find_element_type(id);
+    for (const FactorDegree& f : jacobian_factor_degrees(type.family, type.order))
+      EXPECT_NE(generated_factor_edge_lines(f.dim, f.degree), nullptr) << type.name;
+  }
+  const auto all = generated_factor_edge_lines();
+  ASSERT_GE(all.size(), 20u);
+  for (const FactorEdgeLinesView& view : all) {
+    SCOPED_TRACE("factor dim " + std::to_string(view.dim) + " degree " + std::to_string(view.degree));
+    EXPECT_EQ(generated_factor_edge_lines(view.dim, view.degree), &view);  // one per (dim, degree)
+    const FactorEdgeLines built = build_factor_edge_lines(view.dim, view.degree);
+    for (std::size_t k = 0; k < 16; ++k) {
+      EXPECT_EQ(std::vector<int>(view.first[k].begin(), view.first[k].end()), built.first[k]) << "edge slot " << k;
+      EXPECT_EQ(std::vector<int>(view.index[k].begin(), view.index[k].end()), built.index[k]) << "edge slot " << k;
+    }
   }
 }
 
