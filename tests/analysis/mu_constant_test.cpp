@@ -54,11 +54,15 @@ TEST(MuConstant, RatioBoundEnclosesSvdOfEveryMatrixOfTheBox) {
       // The eigenvector-free bounds: around the exact ratio, and as tight as the above.
       ASSERT_LE(both.lower, exact * exact * (1 + 1e-14)) << "trial " << trial;
       ASSERT_GE(both.upper, exact * exact * (1 - 1e-14)) << "trial " << trial;
-      if (exact > 1e-3) EXPECT_LE(both.upper - both.lower, 1e-7 * exact * exact + 1e-11 + 200 * delta) << "trial " << trial;
+      if (exact > 1e-3) {
+        EXPECT_LE(both.upper - both.lower, 1e-7 * exact * exact + 1e-11 + 200 * delta) << "trial " << trial;
+      }
       ASSERT_LE(std::sqrt(lo), exact * (1 + 1e-14)) << "trial " << trial;
       // Tight: the closed form loses only rounding (relative, amplified near degeneracy)
       // and delta.
-      if (exact > 1e-3) EXPECT_GE(std::sqrt(lo), exact * (1 - 1e-8) - 50 * delta / exact) << "trial " << trial;
+      if (exact > 1e-3) {
+        EXPECT_GE(std::sqrt(lo), exact * (1 - 1e-8) - 50 * delta / exact) << "trial " << trial;
+      }
       // Matrices of the box (its corners and random points) are never below the bound.
       for (int s = 0; s < 8 && delta > 0; ++s) {
         Eigen::MatrixXd p = w;

@@ -64,7 +64,9 @@ void check_type(int gmsh_id, int count, double tol, std::mt19937& rng) {
     if (negative) continue;
     ++valid;
     EXPECT_LE(fast.lower, lo + 1e-13) << "element " << e;
-    if (fast.tolerance_met) EXPECT_LE(fast.upper - fast.lower, tol);
+    if (fast.tolerance_met) {
+      EXPECT_LE(fast.upper - fast.lower, tol);
+    }
   }
   EXPECT_GE(valid, count / 2);
   EXPECT_GE(met, count * 9 / 10);

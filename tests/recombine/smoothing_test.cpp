@@ -264,7 +264,9 @@ TEST(Smooth, OrderVisitsEveryMovableNodeOnceAndColoursDoNotTouch) {
           EXPECT_NE(color_of[a], color_of[b]) << "element " << e << " block " << block;
         }
     }
-    if (block < 40) EXPECT_GT(color, 0u) << "several colours expected with blocks of " << block;
+    if (block < 40) {
+      EXPECT_GT(color, 0u) << "several colours expected with blocks of " << block;
+    }
   }
 }
 
