@@ -12,6 +12,7 @@
 #include <functional>
 #include <vector>
 
+#include "analysis/bilinear_quad_quality.hpp"
 #include "analysis/lane_vector.hpp"
 #include "analysis/mu_constant.hpp"
 #include "analysis/mu_control_bound.hpp"
@@ -211,8 +212,10 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   auto& free_slots = scratch.free_slots;
   free_slots.clear();
   pool.resize(block);
-  if (validity == Validity::valid && mu_constant_path_enabled())
+  if (validity == Validity::valid && mu_constant_path_enabled()) {
     if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol)) return *straight;
+    if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol)) return *bilinear;
+  }
   const double err0 = element_w(space, nodes, pool.data());
   // Constant W (straight-sided simplices, parallelograms, parallelepipeds): W's control
   // values agree to 1e-9 relative. Then one corner's upper bound serves for all (they

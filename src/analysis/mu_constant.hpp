@@ -9,7 +9,8 @@
 namespace quadval {
 
 /// Tests only: switch the constant-W path of mu_bounds off (on by default) in the calling
-/// thread, to compare it with the general path.
+/// thread, with the closed forms of straight simplices and bilinear quadrangles
+/// (bilinear_quad_quality.hpp), to compare them with the general path.
 void mu_use_constant_path(bool on) noexcept;
 bool mu_constant_path_enabled() noexcept;
 

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "analysis/bilinear_quad_quality.hpp"
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/lane_vector.hpp"
 #include "analysis/linear_jacobian.hpp"
@@ -541,8 +542,11 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   const auto udim = static_cast<std::size_t>(dim);
   const std::size_t frames = space.frames().size();
 
-  if (v == Validity::valid)
+  if (v == Validity::valid) {
     if (const auto straight = straight_simplex_bounds(space, nodes, planar, options.abs_tol)) return *straight;
+    if (use_straight_path && planar)
+      if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes, options.abs_tol)) return *bilinear;
+  }
   thread_local Polys polys;
   const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2
   columns_and_jacobian(space, nodes, planar, polys, ws.values);

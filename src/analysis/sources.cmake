@@ -18,6 +18,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/ratio_refinement.cpp
   src/analysis/scaled_jacobian_space.cpp
   src/analysis/scaled_jacobian_quotient.cpp
+  src/analysis/bilinear_quad_quality.cpp
   src/analysis/scaled_jacobian.cpp
   src/analysis/mu_space.cpp
   src/analysis/mu_metric.cpp

@@ -14,6 +14,7 @@
 #include "quadval/lagrange_basis.hpp"
 #include "quadval/mu_bounds.hpp"
 #include "jacobian_test_util.hpp"
+#include "scaled_jacobian_test_util.hpp"
 
 namespace quadval {
 namespace {
@@ -148,6 +149,57 @@ TEST(MuConstant, StraightSidedSimplicesWithTinyDeviations) {
       EXPECT_LE(g.lower, q.upper) << type.name << " element " << e;
     }
   }
+}
+
+// Valid planar quadrangles with a bilinear geometry get closed-form bounds
+// (bilinear_quad_quality.hpp: the minimum of mu is at a corner): the least corner value
+// (Eigen's SVD), which dense sampling never finds below (the theorem, checked here
+// independently), lies within them; with the high-order nodes 1e-10 off the bilinear map
+// the bounds still hold the sampled minimum and overlap the general path's.
+TEST(MuConstant, BilinearQuadrangleMinimumIsAtACorner) {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-1, 1);
+  QualityOptions opt;
+  opt.abs_tol = 1e-6;
+  int checked = 0;
+  for (int order = 1; order <= 4; ++order) {
+    const ElementType& type = *find_element_type(ElementFamily::quadrangle, order, true);
+    const LagrangeBasis& basis = lagrange_basis(type);
+    const auto points = test::dense_points(type.family, 24, 200, rng);
+    for (int e = 0; e < 40; ++e) {
+      const double z = 5 * u(rng), scale = std::pow(10.0, 3 * u(rng));
+      std::vector<test::Vec> q = {{0, 0, z}, {1, 0, z}, {1, 1, z}, {0, 1, z}};
+      for (test::Vec& v : q)
+        for (std::size_t j = 0; j < 2; ++j) v[j] = scale * (v[j] + 0.4 * u(rng));
+      std::vector<double> x = test::straight_element(type, q);
+      for (std::size_t i = 2; i < x.size(); i += 3) x[i] = z;  // exactly, as a 2D mesher writes it
+      const bool off = order > 1 && e % 2 == 1;
+      if (off)
+        for (std::size_t i = 12; i < x.size(); ++i)
+          if (i % 3 != 2) x[i] += 1e-10 * scale * u(rng);
+      double corner_min = 1;
+      for (std::size_t k = 0; k < 4; ++k) corner_min = std::min(corner_min, test::pointwise_mu(basis, x, reference_nodes(type)[k]));
+      const test::SampledMu sampled = test::sample_mu(basis, x, points);
+      if (sampled.j_nonpositive || !(corner_min > 0.05)) continue;  // the general path's case
+      if (!off) {
+        EXPECT_GE(sampled.lo, corner_min * (1 - 1e-12)) << type.name << " element " << e;  // the theorem
+      }
+      const QualityBounds b = mu_bounds(type, x, opt, true);
+      EXPECT_LE(b.lower, sampled.lo * (1 + 1e-12)) << type.name << " element " << e;
+      EXPECT_LE(b.lower, corner_min * (1 + 1e-12)) << type.name << " element " << e;
+      EXPECT_GE(b.upper, corner_min - (off ? 1e-6 : 1e-12)) << type.name << " element " << e;
+      EXPECT_LE(b.upper - b.lower, off ? 1e-6 : 1e-9) << type.name << " element " << e;
+      EXPECT_EQ(b.subdivisions, 0) << type.name << " element " << e;
+      EXPECT_TRUE(b.tolerance_met) << type.name << " element " << e;
+      mu_use_constant_path(false);
+      const QualityBounds g = mu_bounds(type, x, opt, true);
+      mu_use_constant_path(true);
+      EXPECT_LE(b.lower, g.upper) << type.name << " element " << e;
+      EXPECT_LE(g.lower, b.upper) << type.name << " element " << e;
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 100);
 }
 
 TEST(MuConstant, CurvedElementsAreNotTakenForConstant) {

@@ -363,6 +363,55 @@ TEST(ScaledJacobian, StraightSimplicesInClosedFormHoldTheValue) {
   EXPECT_GE(checked, 40);
 }
 
+// Valid planar quadrangles with a bilinear geometry get closed-form bounds
+// (bilinear_quad_quality.hpp: the minimum of sj is at a corner): the least corner value, which
+// dense sampling never finds below (the theorem, checked here independently), lies within
+// them, without subdivisions; with the high-order nodes 1e-10 off the bilinear map the
+// bounds still hold the sampled minimum and overlap the general path's.
+TEST(ScaledJacobian, BilinearQuadrangleMinimumIsAtACorner) {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int checked = 0;
+  for (int order = 1; order <= 4; ++order) {
+    const ElementType& t = type_of(ElementFamily::quadrangle, order);
+    SCOPED_TRACE(std::string(t.name));
+    const auto points = test::dense_points(t.family, 24, 200, rng);
+    for (int e = 0; e < 40; ++e) {
+      const double z = 5 * u(rng), scale = std::pow(10.0, 3 * u(rng));
+      std::vector<Vec> q = {{0, 0, z}, {1, 0, z}, {1, 1, z}, {0, 1, z}};
+      for (Vec& v : q)
+        for (int j = 0; j < 2; ++j) v[static_cast<std::size_t>(j)] = scale * (v[static_cast<std::size_t>(j)] + 0.4 * u(rng));
+      std::vector<double> x = straight_element(t, q);
+      for (std::size_t i = 2; i < x.size(); i += 3) x[i] = z;  // exactly, as a 2D mesher writes it
+      const bool off = order > 1 && e % 2 == 1;
+      if (off)
+        for (std::size_t i = 12; i < x.size(); ++i)
+          if (i % 3 != 2) x[i] += 1e-10 * scale * u(rng);
+      double corner_min = INFINITY;
+      for (int k = 0; k < 4; ++k) corner_min = std::min(corner_min, sj_at(t, x, reference_nodes(t)[static_cast<std::size_t>(k)], {0, 0, 1}, chord(x)));
+      if (!(corner_min > 0.05)) continue;  // not convex enough: the general path's case
+      const double sampled = sampled_min(t, x, points);
+      if (!off) {
+        EXPECT_GE(sampled, corner_min - 1e-12);  // the minimum is at a corner
+      }
+      const QualityBounds b = bounds(t, x, 1e-6);
+      EXPECT_LE(b.lower, sampled + 1e-12);
+      EXPECT_LE(b.lower, corner_min + 1e-12);
+      EXPECT_GE(b.upper, corner_min - (off ? 1e-6 : 1e-12));
+      EXPECT_LE(b.upper - b.lower, off ? 1e-6 : 1e-9);  // the margins of rounding and of the nodes
+      EXPECT_EQ(b.subdivisions, 0);
+      EXPECT_TRUE(b.tolerance_met);
+      scaled_jacobian_use_straight_path(false);
+      const QualityBounds g = bounds(t, x, 1e-6);
+      scaled_jacobian_use_straight_path(true);
+      EXPECT_LE(b.lower, g.upper);
+      EXPECT_LE(g.lower, b.upper);
+      ++checked;
+    }
+  }
+  EXPECT_GE(checked, 100);
+}
+
 // The first stage's bounds `stage` of element e enclose sj(E): lower <= upper, lower never
 // above the full certified upper bound nor the sampled minimum (pyramids: no sampler
 // here), upper never below the full certified lower bound.
