@@ -24,6 +24,7 @@
 #include "analysis/scaled_jacobian_quotient.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/straight_sided.hpp"
+#include "analysis/trilinear_hex_sj.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
@@ -546,6 +547,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     if (const auto straight = straight_simplex_bounds(space, nodes, planar, options.abs_tol)) return *straight;
     if (use_straight_path && planar)
       if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes, options.abs_tol)) return *bilinear;
+    if (use_straight_path && type.family == ElementFamily::hexahedron && type.num_nodes == 8)
+      if (const auto hex = trilinear_hex_sj_bounds(nodes, options.abs_tol)) return *hex;
   }
   thread_local Polys polys;
   const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2

@@ -18,6 +18,7 @@
 #include "quadval/lagrange_basis.hpp"
 #include "quadval/scaled_jacobian.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "analysis/trilinear_hex_sj.hpp"
 
 namespace quadval {
 namespace {
@@ -410,6 +411,41 @@ TEST(ScaledJacobian, BilinearQuadrangleMinimumIsAtACorner) {
     }
   }
   EXPECT_GE(checked, 100);
+}
+
+// The fixed-size root bound of valid first-order hexahedra (trilinear_hex_sj.hpp) against
+// dense sampling and the general path (at 1e-6): never above a sampled value nor above the
+// general upper bound, its upper bound (a corner value) never below the general lower one;
+// and it settles most distorted hexahedra at the default tolerance, as the general path's
+// root does.
+TEST(ScaledJacobian, FirstOrderHexahedronRootBoundHoldsTheMinimum) {
+  std::mt19937 rng(51);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const ElementType& t = type_of(ElementFamily::hexahedron, 1);
+  const auto points = test::dense_points(t.family, 10, 300, rng);
+  int checked = 0, settled = 0;
+  for (int e = 0; e < 300; ++e) {
+    const double scale = std::pow(10.0, 2 * u(rng)), amplitude = e % 3 == 0 ? 0.05 : 0.3;
+    const Vec shift = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
+    std::vector<double> x;
+    for (const RefPoint& p : reference_nodes(t))
+      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + amplitude * u(rng)) + shift[j]);
+    const double sampled = sampled_min(t, x, points);
+    if (!(sampled > 0.02)) continue;  // invalid or nearly so: not this path's case
+    const auto root = trilinear_hex_sj_bounds(x, 1.0);
+    ASSERT_TRUE(root.has_value()) << "element " << e;
+    scaled_jacobian_use_straight_path(false);
+    const QualityBounds g = bounds(t, x, 1e-6);
+    scaled_jacobian_use_straight_path(true);
+    EXPECT_LE(root->lower, sampled + 1e-12) << "element " << e;
+    EXPECT_LE(root->lower, g.upper) << "element " << e;
+    EXPECT_LE(g.lower, root->upper) << "element " << e;
+    EXPECT_GE(root->upper, sampled - 1e-12 - (root->upper - g.lower)) << "element " << e;
+    if (trilinear_hex_sj_bounds(x, 1e-2)) ++settled;
+    ++checked;
+  }
+  EXPECT_GE(checked, 200);
+  EXPECT_GE(settled, checked * 3 / 4);
 }
 
 // The first stage's bounds `stage` of element e enclose sj(E): lower <= upper, lower never
