@@ -53,10 +53,10 @@ struct Quad {
   double m = 0;            // |J - J_1| <= m
   std::array<double, 3> beta{0, 0, 0};
 
-  bool read(const ElementType& type, std::span<const double> x) {
+  bool read(const ElementType& type, std::span<const double> x, const KnownMargin* known) {
     if (type.family != ElementFamily::quadrangle || !in_a_z_plane(x)) return false;
     if (type.order > 1) {
-      m = straight_sided_margin(type).margin(x.data(), beta);
+      m = straight_margin_of(type, x.data(), known, beta);
       if (!(m < kInf)) return false;
     }
     // c_1 runs from e[0] / 2 (eta = -1) to e[1] / 2, c_2 from f[0] / 2 (xi = -1) to f[1] / 2.
@@ -105,9 +105,9 @@ std::optional<QualityBounds> within(QualityBounds out, double tol) {
 }  // namespace
 
 std::optional<QualityBounds> bilinear_quad_sj_bounds(const ElementType& type, std::span<const double> x,
-                                                     double tol) {
+                                                     double tol, const KnownMargin* known) {
   Quad quad;
-  if (!quad.read(type, x)) return std::nullopt;
+  if (!quad.read(type, x, known)) return std::nullopt;
   double s_lo = kInf, upper = kInf;
   const Corner* least = nullptr;
   for (const Corner& c : quad.corner) {
@@ -136,9 +136,9 @@ std::optional<QualityBounds> bilinear_quad_sj_bounds(const ElementType& type, st
 }
 
 std::optional<QualityBounds> bilinear_quad_mu_bounds(const ElementType& type, std::span<const double> x,
-                                                     double tol) {
+                                                     double tol, const KnownMargin* known) {
   Quad quad;
-  if (!quad.read(type, x)) return std::nullopt;
+  if (!quad.read(type, x, known)) return std::nullopt;
   double r_lo = kInf, upper = kInf;
   const Corner* least = nullptr;
   for (const Corner& c : quad.corner) {

@@ -43,6 +43,7 @@
 #include <optional>
 #include <span>
 
+#include "analysis/straight_sided.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/quality_bounds.hpp"
 
@@ -52,11 +53,12 @@ namespace quadval {
 /// along +z. Nothing when the element is not such, its first-order J is not proven positive
 /// at the corners, its nodes are off the bilinear map by more than the straight-sided
 /// margin allows, or upper - lower > tol.
+/// @param known the element's margin (straight_sided.hpp), when the caller has it
 std::optional<QualityBounds> bilinear_quad_sj_bounds(const ElementType& type, std::span<const double> x,
-                                                     double tol);
+                                                     double tol, const KnownMargin* known = nullptr);
 
 /// The same for mu(E).
 std::optional<QualityBounds> bilinear_quad_mu_bounds(const ElementType& type, std::span<const double> x,
-                                                     double tol);
+                                                     double tol, const KnownMargin* known = nullptr);
 
 }  // namespace quadval

@@ -204,8 +204,11 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   qo.abs_tol = options.quality_abs_tol;
   qo.max_subdivisions = options.max_subdivisions;
 
-  // First-order fast path (linear_jacobian.hpp): validity only; measuring refines further.
-  const bool fast_path = options.measure == CheckMeasure::validity;
+  // First-order fast path (linear_jacobian.hpp) for validity, and for mu and the scaled
+  // Jacobian, which need only the sign of J (their closed forms of straight-sided elements
+  // take the margins it computes); measuring J's range refines further.
+  const bool fast_path = options.measure == CheckMeasure::validity || options.measure == CheckMeasure::mu ||
+                         options.measure == CheckMeasure::scaled_jacobian;
 
   // Work list: (block, first element) chunks of the analysed dimension.
   struct Chunk {
@@ -351,7 +354,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(thread)];
-    std::vector<double> nodes, errors, coeffs, soa, margins;
+    std::vector<double> nodes, errors, coeffs, soa, margins, betas, element_nodes;
     std::vector<std::size_t> rest;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
@@ -401,15 +404,26 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             const auto nn = static_cast<std::size_t>(type.num_nodes);
             // mu or the scaled Jacobian of one element, or a skip said so.
             const auto quality = [&](bool supported, QualityBounds& out, QualityCounts& qc, const double* xe,
-                                     auto bounds_of) {
+                                     const KnownMargin* known, auto bounds_of) {
               if (!supported) {
                 ++qc.skipped;
                 ++qc.skipped_types[type.gmsh_id];
                 return;
               }
-              out = bounds_of(type, std::span<const double>(xe, nn * 3), qo, report.planar);
+              out = bounds_of(type, std::span<const double>(xe, nn * 3), qo, report.planar, known);
               ++qc.computed;
               if (!out.tolerance_met) ++qc.tolerance_not_met;
+            };
+            // mu and the scaled Jacobian of an element whose validity is known.
+            const auto qualities = [&](std::size_t index, const double* xe, Validity v, const KnownMargin* known) {
+              if (want_mu)
+                quality(mu_supported(type), mu[index], st.mu, xe, known,
+                        [v](const ElementType& t, std::span<const double> x, const QualityOptions& q, bool planar,
+                            const KnownMargin* k) { return mu_bounds_given(t, x, q, planar, v, k); });
+              if (want_sj)
+                quality(scaled_jacobian_supported(type), sj[index], st.sj, xe, known,
+                        [v](const ElementType& t, std::span<const double> x, const QualityOptions& q, bool planar,
+                            const KnownMargin* k) { return scaled_jacobian_bounds_given(t, x, q, planar, v, k); });
             };
             // What every analysed element gets once its bounds are known.
             const auto finish = [&](std::size_t index, const double* xe, double ticks) {
@@ -418,25 +432,27 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               const JacobianBounds& b = ec.bounds;
               if (want_distortion)
                 distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws, bo);
-              if (want_mu)
-                quality(mu_supported(type), mu[index], st.mu, xe,
-                        [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
-                                         bool planar) { return mu_bounds_given(t, x, q, planar, v); });
-              if (want_sj)
-                quality(scaled_jacobian_supported(type), sj[index], st.sj, xe,
-                        [v = b.validity](const ElementType& t, std::span<const double> x, const QualityOptions& q,
-                                         bool planar) { return scaled_jacobian_bounds_given(t, x, q, planar, v); });
+              qualities(index, xe, b.validity, nullptr);
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
-            // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp):
-            // that is only on the fast path, which measures validity alone, and the chunk
-            // never takes the exact fallback, so only the bookkeeping is left.
-            const auto finish_first_order = [&](std::size_t index, const JacobianBounds& b, double ticks) {
+            // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp),
+            // which never takes the exact fallback: the bookkeeping, and mu and the scaled
+            // Jacobian from the element's nodes (with the chunk's straight-sided margin, if
+            // it has one).
+            const auto finish_first_order = [&](std::size_t index, std::size_t element, const JacobianBounds& b,
+                                                double ticks, const KnownMargin* known) {
               ElementCheck& ec = elements[index];
               ec.bounds = b;
               ec.analysed = true;
               st.add(b.stage, b.validity, ticks);
+              if (!want_mu && !want_sj) return;
+              const auto conn = blk.element(element);
+              element_nodes.resize(nn * 3);
+              for (std::size_t k = 0; k < nn; ++k)
+                for (std::size_t j = 0; j < 3; ++j)
+                  element_nodes[k * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
+              qualities(index, element_nodes.data(), b.validity, known);
             };
             if (fast != LinearKind::none) {
               // First-order fast path (linear_jacobian.hpp): the coefficients straight from
@@ -464,7 +480,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 ElementCheck& ec = elements[ch.out + i];
                 const auto conn = blk.element(ch.first + i);
                 if (decided[i]) {
-                  finish_first_order(ch.out + i, fast_bounds[i], share);
+                  finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share, nullptr);
                   continue;
                 }
                 const std::uint64_t te = stage_ticks();
@@ -496,7 +512,9 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 const double* coords = mesh.coords.data();
                 const NodeIndex* first_conn = blk.element(ch.first).data();
                 margins.resize(kChunk);
-                straight->margins(coords, first_conn, ch.count, margins.data());
+                betas.resize(3 * kChunk);
+                straight->margins(coords, first_conn, ch.count, margins.data(),
+                                  want_mu || want_sj ? betas.data() : nullptr);
                 if (std::any_of(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(ch.count),
                                 [](double m) { return std::isfinite(m); })) {
                   constexpr std::size_t kRow = kChunk + 8;  // rows a cache line apart beyond the chunk
@@ -523,7 +541,11 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                     rest[left++] = i;
                     continue;
                   }
-                  finish_first_order(ch.out + i, fast_bounds[i], share);
+                  KnownMargin known;
+                  known.margin = margins[i];
+                  std::copy_n(betas.begin() + static_cast<std::ptrdiff_t>(3 * i), 3, known.beta.begin());
+                  finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share,
+                                     want_mu || want_sj ? &known : nullptr);
                 }
               } else {
                 for (std::size_t i = 0; i < ch.count; ++i) rest[left++] = i;

@@ -122,7 +122,7 @@ bool handled_family(ElementFamily f) {
 // of `w` (the layout those functions read). Nothing when not such a simplex, or when the
 // bounds are wider than tol.
 std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span<const double> x, double* w,
-                                                 double tol) {
+                                                 double tol, const KnownMargin* known) {
   constexpr double kInf = std::numeric_limits<double>::infinity();
   constexpr double kUnit = 0x1p-53;
   const ElementType& type = space.type();
@@ -130,7 +130,7 @@ std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span
                        (type.family == ElementFamily::triangle && in_a_z_plane(x));
   if (!simplex) return std::nullopt;
   std::array<double, 3> beta{0, 0, 0};
-  if (type.order > 1 && !(straight_sided_margin(type).margin(x.data(), beta) < kInf)) return std::nullopt;
+  if (type.order > 1 && !(straight_margin_of(type, x.data(), known, beta) < kInf)) return std::nullopt;
   const auto dim = static_cast<std::size_t>(type.dim);
   double a[3][3] = {}, a_max[3] = {0, 0, 0};
   for (std::size_t c = 0; c < dim; ++c)
@@ -186,7 +186,7 @@ QualityBounds mu_bounds(const ElementType& type, std::span<const double> nodes,
 
 QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> nodes,
                               const QualityOptions& options, bool /*planar: settled by validity*/,
-                              Validity validity) {
+                              Validity validity, const KnownMargin* known) {
   QV_ASSERT(mu_supported(type), "mu bounds do not handle " << type.name);
   QV_ASSERT(nodes.size() == static_cast<std::size_t>(3 * type.num_nodes),
             nodes.size() << " coordinates for " << type.name);
@@ -213,8 +213,8 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   free_slots.clear();
   pool.resize(block);
   if (validity == Validity::valid && mu_constant_path_enabled()) {
-    if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol)) return *straight;
-    if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol)) return *bilinear;
+    if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol, known)) return *straight;
+    if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
   }
   const double err0 = element_w(space, nodes, pool.data());
   // Constant W (straight-sided simplices, parallelograms, parallelepipeds): W's control

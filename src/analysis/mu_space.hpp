@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/jacobian_product.hpp"
+#include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/bezier_basis.hpp"
@@ -147,7 +148,10 @@ const MuSpace& mu_space(const ElementType& type);
 /// mu_bounds (quadval/mu_bounds.hpp) with the element's validity already settled by the
 /// Jacobian engine (validity goal or finer), as check_mesh has it: the same bounds
 /// without computing it again. @pre validity is the certified answer for these nodes
+/// @param known the element's straight-sided margin, when the caller has it (the same
+///              bounds, without computing it again)
 QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> nodes,
-                              const QualityOptions& options, bool planar, Validity validity);
+                              const QualityOptions& options, bool planar, Validity validity,
+                              const KnownMargin* known = nullptr);
 
 }  // namespace quadval

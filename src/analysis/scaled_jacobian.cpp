@@ -454,14 +454,14 @@ thread_local bool use_straight_path = true;
 // The minimum over the frames of each bound bounds min sj. Nothing when the element is not
 // such a simplex or the bounds are wider than tol.
 std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& space, std::span<const double> x,
-                                                     bool planar, double tol) {
+                                                     bool planar, double tol, const KnownMargin* known) {
   const ElementType& type = space.type();
   const bool triangle = type.family == ElementFamily::triangle && planar && in_a_z_plane(x);
   if (!use_straight_path || !(triangle || type.family == ElementFamily::tetrahedron)) return std::nullopt;
   std::array<double, 3> beta{0, 0, 0};
   double m = 0;
   if (type.order > 1) {
-    m = straight_sided_margin(type).margin(x.data(), beta);
+    m = straight_margin_of(type, x.data(), known, beta);
     if (!(m < kInf)) return std::nullopt;
   }
   const LinearKind kind = triangle ? LinearKind::triangle : LinearKind::tetrahedron;
@@ -531,7 +531,8 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
 }
 
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
-                                           const QualityOptions& options, bool planar, Validity v) {
+                                           const QualityOptions& options, bool planar, Validity v,
+                                           const KnownMargin* known) {
   QV_ASSERT(scaled_jacobian_supported(type), "no scaled Jacobian for " << type.name);
   QV_ASSERT(nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
             "nodes " << nodes.size() << " for " << type.name);
@@ -544,9 +545,9 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   const std::size_t frames = space.frames().size();
 
   if (v == Validity::valid) {
-    if (const auto straight = straight_simplex_bounds(space, nodes, planar, options.abs_tol)) return *straight;
+    if (const auto straight = straight_simplex_bounds(space, nodes, planar, options.abs_tol, known)) return *straight;
     if (use_straight_path && planar)
-      if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes, options.abs_tol)) return *bilinear;
+      if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
     if (use_straight_path && type.family == ElementFamily::hexahedron && type.num_nodes == 8)
       if (const auto hex = trilinear_hex_sj_bounds(nodes, options.abs_tol)) return *hex;
   }

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "analysis/jacobian_space.hpp"
+#include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
@@ -95,7 +96,10 @@ void scaled_jacobian_use_straight_path(bool on) noexcept;
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian
 /// engine (jacobian_bounds, any goal: only the sign of min J is used), as check_mesh has
 /// it; results are identical. @pre v is that element's certified validity.
+/// @param known the element's straight-sided margin, when the caller has it (the same
+///              bounds, without computing it again)
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
-                                           const QualityOptions& options, bool planar, Validity v);
+                                           const QualityOptions& options, bool planar, Validity v,
+                                           const KnownMargin* known = nullptr);
 
 }  // namespace quadval

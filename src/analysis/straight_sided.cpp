@@ -183,8 +183,8 @@ double StraightSidedMargin::margin(const double* nodes, std::array<double, 3>& b
 // one, then one per axis) took 62 ns per element of tri_h0.4_o4 against 39 for these loads
 // (gathers are slow on this CPU); loading through a stack array gained nothing with
 // link-time optimisation (25.5 ns either way).
-void StraightSidedMargin::margins(const double* coords, const NodeIndex* conn, std::size_t count,
-                                  double* out) const noexcept {
+void StraightSidedMargin::margins(const double* coords, const NodeIndex* conn, std::size_t count, double* out,
+                                  double* beta) const noexcept {
   if (kind_ == LinearKind::none) {
     std::fill(out, out + count, kInf);
     return;
@@ -193,15 +193,16 @@ void StraightSidedMargin::margins(const double* coords, const NodeIndex* conn, s
   for (std::size_t e = 0; e < count; e += kLanes) {
     const NodeIndex* lane[kLanes];
     for (std::size_t l = 0; l < kLanes; ++l) lane[l] = conn + std::min(e + l, count - 1) * nn;
-    double m[kLanes];
+    double m[kLanes], b[kLanes * 3] = {};
     lane_margins<kLanes>(
         [&](std::size_t i, std::size_t j) {
           Lanes<kLanes> v;
           for (std::size_t l = 0; l < kLanes; ++l) v[l] = coords[3 * static_cast<std::size_t>(lane[l][i]) + j];
           return v;
         },
-        m);
+        m, beta != nullptr ? b : nullptr);
     std::copy_n(m, std::min(kLanes, count - e), out + e);
+    if (beta != nullptr) std::copy_n(b, 3 * std::min(kLanes, count - e), beta + 3 * e);
   }
 }
 

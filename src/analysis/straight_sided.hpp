@@ -58,7 +58,9 @@ class StraightSidedMargin {
   /// order), 8 elements at a time; 8 curved ones are read only up to the first node that
   /// shows all of them curved.
   /// @param out count margins
-  void margins(const double* coords, const NodeIndex* conn, std::size_t count, double* out) const noexcept;
+  /// @param beta optional, count x 3: each element's beta_c as margin() gives them
+  void margins(const double* coords, const NodeIndex* conn, std::size_t count, double* out,
+               double* beta = nullptr) const noexcept;
 
   /// One element: its margin as above and beta_c >= |D_c| everywhere, the distance of
   /// column c of the Jacobian matrix from the first-order element's (meaningless where the
@@ -89,6 +91,23 @@ class StraightSidedMargin {
 /// The margin of `type` for 2D elements in a plane z = const (x, y only) and 3D elements,
 /// built once per thread (for the quality measures, element by element).
 const StraightSidedMargin& straight_sided_margin(const ElementType& type);
+
+/// An element's margin and column distances (StraightSidedMargin::margin), when the caller
+/// has them already: check_mesh computes them 8 elements at a time for its validity.
+struct KnownMargin {
+  double margin = 0;
+  std::array<double, 3> beta{0, 0, 0};
+};
+
+/// straight_sided_margin(type).margin(nodes, beta), or `known`'s when given.
+inline double straight_margin_of(const ElementType& type, const double* nodes, const KnownMargin* known,
+                                 std::array<double, 3>& beta) {
+  if (known != nullptr) {
+    beta = known->beta;
+    return known->margin;
+  }
+  return straight_sided_margin(type).margin(nodes, beta);
+}
 
 /// True when every node of the element has the z of node 0 (a 2D element in a plane
 /// z = const, where the 2D margin holds).

@@ -15,6 +15,8 @@
 #include "quadval/check_report.hpp"
 #include "quadval/jacobian_bounds.hpp"
 #include "quadval/lagrange_basis.hpp"
+#include "quadval/mu_bounds.hpp"
+#include "quadval/scaled_jacobian.hpp"
 
 namespace quadval {
 namespace {
@@ -234,6 +236,53 @@ TEST(StraightSided, CheckDecidesStraightElementsAsTheGeneralPath) {
   EXPECT_GT(answers[static_cast<int>(Validity::valid)], 0u);
   EXPECT_GT(answers[static_cast<int>(Validity::invalid)], 0u);
   EXPECT_EQ(answers[static_cast<int>(Validity::undetermined)], 0u);
+}
+
+// With mu or the scaled Jacobian measured, check settles validity by the fast paths too
+// (first-order chunks, straight-sided margins computed 8 elements at a time and handed to
+// the quality bounds): every element's bounds equal, bit for bit, those of mu_bounds and
+// scaled_jacobian_bounds called on it alone.
+TEST(StraightSided, CheckQualityOnTheFastPathsEqualsTheElementsOwn) {
+  std::mt19937 rng(17);
+  std::vector<const ElementType*> types;
+  for (const ElementType* t : straight_types())
+    if (t->order <= 3) types.push_back(t);
+  for (ElementFamily f : {ElementFamily::triangle, ElementFamily::quadrangle, ElementFamily::tetrahedron,
+                          ElementFamily::hexahedron})
+    types.push_back(find_element_type(f, 1, true));
+  std::size_t compared = 0;
+  for (const ElementType* type : types) {
+    std::vector<std::vector<double>> elements;
+    for (int e = 0; e < 24; ++e) {
+      std::vector<double> x = straight_element(*type, 0.15, e % 2 == 0 ? 0.0 : 1e-10, rng);
+      if (e % 5 == 0)  // mirrored: J < 0 everywhere
+        for (std::size_t i = 0; i < x.size(); i += 3) x[i] = -x[i];
+      if (type->dim == 2)  // in the plane z = 0, as a 2D mesher writes it
+        for (std::size_t i = 2; i < x.size(); i += 3) x[i] = 0;
+      elements.push_back(x);
+    }
+    const Mesh mesh = test::mesh_of_elements(*type, elements);
+    for (const CheckMeasure measure : {CheckMeasure::mu, CheckMeasure::scaled_jacobian}) {
+      CheckOptions o;
+      o.measure = measure;
+      const CheckReport r = check_mesh(mesh, o);
+      ASSERT_EQ(r.elements.size(), elements.size());
+      QualityOptions qo;
+      qo.abs_tol = o.quality_abs_tol;
+      qo.max_subdivisions = o.max_subdivisions;
+      for (std::size_t e = 0; e < elements.size(); ++e) {
+        const bool mu = measure == CheckMeasure::mu;
+        const QualityBounds got = mu ? r.mu_of(e) : r.sj_of(e);
+        const QualityBounds want =
+            mu ? mu_bounds(*type, elements[e], qo, true) : scaled_jacobian_bounds(*type, elements[e], qo, true);
+        EXPECT_EQ(got.lower, want.lower) << type->name << (mu ? " mu" : " sj") << " element " << e;
+        EXPECT_EQ(got.upper, want.upper) << type->name << (mu ? " mu" : " sj") << " element " << e;
+        EXPECT_EQ(got.tolerance_met, want.tolerance_met) << type->name << " element " << e;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_GT(compared, 800u);
 }
 
 }  // namespace
