@@ -477,7 +477,14 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
       a[c][j] = x[3 * (c + 1) + j] - x[j];
       a_norm1[c] += std::abs(a[c][j]);
     }
-  QualityBounds out{kInf, kInf, 0, false};
+  // In plain arithmetic: every quantity below is nonnegative and its norms lie in
+  // [2^-300, 2^300] (else the general path), so nothing underflows or overflows, and each
+  // operation adds a relative error of at most u (the differences norm - e too, as e is at
+  // most half the norm). Fewer than 40 roundings reach a frame's quotient, so widening the
+  // least quotients by kSlack (about 9e4 u) covers them all; directed roundings at every
+  // step cost twice as much on straight tetrahedra.
+  constexpr double kSlack = 1e-11, kSmall = 0x1p-300, kLarge = 0x1p300;
+  double lower = kInf, upper = kInf;
   for (const Frame& fr : space.frames()) {
     double den_hi = 1, den_lo = 1;
     for (std::size_t j = 0; j < dim; ++j) {
@@ -488,14 +495,14 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
         e += beta[c] + 4 * kUnit * a_norm1[c];
       }
       const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      e = up(e * (1 + 1e-12));
-      den_hi = up(den_hi * up(up(norm * (1 + 1e-12)) + e));
-      den_lo = down(den_lo * std::max(0.0, down(down(norm * (1 - 1e-12)) - e)));
+      if (!(norm >= kSmall && norm <= kLarge && e <= 0.5 * norm)) return std::nullopt;
+      den_hi *= norm + e;
+      den_lo *= norm - e;
     }
-    if (!(den_lo > 0)) return std::nullopt;
-    out.lower = std::min(out.lower, down(space.s_lo() * down(j_lo / den_hi)));
-    out.upper = std::min(out.upper, up(space.s_hi() * up(j_hi / den_lo)));
+    lower = std::min(lower, j_lo / den_hi);
+    upper = std::min(upper, j_hi / den_lo);
   }
+  QualityBounds out{down(space.s_lo() * lower * (1 - kSlack)), up(space.s_hi() * upper * (1 + kSlack)), 0, false};
   out.tolerance_met = up(out.upper - out.lower) <= tol;
   if (!out.tolerance_met) return std::nullopt;
   return out;
