@@ -108,6 +108,15 @@ QualityBounds bounds(const ElementType& t, const std::vector<double>& x, double 
   return scaled_jacobian_bounds(t, x, o, planar);
 }
 
+// The general path's bounds (closed forms and root formulas off) overlap b: both enclose sj(E).
+void expect_overlaps_general_path(const ElementType& t, const std::vector<double>& x, const QualityBounds& b) {
+  scaled_jacobian_use_straight_path(false);
+  const QualityBounds g = bounds(t, x, 1e-6);
+  scaled_jacobian_use_straight_path(true);
+  EXPECT_LE(b.lower, g.upper);
+  EXPECT_LE(g.lower, b.upper);
+}
+
 void expect_value(const ElementType& t, const std::vector<double>& x, double want, bool planar = true) {
   SCOPED_TRACE(std::string(t.name));
   const QualityBounds b = bounds(t, x, 1e-9, planar);
@@ -353,11 +362,7 @@ TEST(ScaledJacobian, StraightSimplicesInClosedFormHoldTheValue) {
       }
       EXPECT_EQ(b.subdivisions, 0);
       EXPECT_TRUE(b.tolerance_met);
-      scaled_jacobian_use_straight_path(false);
-      const QualityBounds g = bounds(t, x, 1e-6);
-      scaled_jacobian_use_straight_path(true);
-      EXPECT_LE(b.lower, g.upper);
-      EXPECT_LE(g.lower, b.upper);
+      expect_overlaps_general_path(t, x, b);
       ++checked;
     }
   }
@@ -402,11 +407,7 @@ TEST(ScaledJacobian, BilinearQuadrangleMinimumIsAtACorner) {
       EXPECT_LE(b.upper - b.lower, off ? 1e-6 : 1e-9);  // the margins of rounding and of the nodes
       EXPECT_EQ(b.subdivisions, 0);
       EXPECT_TRUE(b.tolerance_met);
-      scaled_jacobian_use_straight_path(false);
-      const QualityBounds g = bounds(t, x, 1e-6);
-      scaled_jacobian_use_straight_path(true);
-      EXPECT_LE(b.lower, g.upper);
-      EXPECT_LE(g.lower, b.upper);
+      expect_overlaps_general_path(t, x, b);
       ++checked;
     }
   }
