@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 
 namespace quadval {
@@ -28,7 +29,7 @@ Edge edge(std::span<const double> nodes, int to, int from) {
   e.x = nodes[3 * static_cast<std::size_t>(to)] - nodes[3 * static_cast<std::size_t>(from)];
   e.y = nodes[3 * static_cast<std::size_t>(to) + 1] - nodes[3 * static_cast<std::size_t>(from) + 1];
   const double sq = e.x * e.x + e.y * e.y;
-  const double n = std::sqrt(sq);
+  const double n = sqrt_rn(sq);
   e.norm_lo = down(n * (1 - 1e-12));
   e.norm_hi = up(n * (1 + 1e-12));
   e.sq_lo = down(sq * (1 - 1e-12));
@@ -88,11 +89,11 @@ struct Quad {
 // mu at a corner: r = 2 / (g + sqrt(g^2 - 4)), g = (|a|^2 + |b|^2) / (a x b), decreasing in g.
 double corner_mu_lower(const Corner& c) {
   const double g = up(up(c.a->sq_hi + c.b->sq_hi) / c.cross_lo);
-  return down(2 / up(g + up(std::sqrt(up(up(g * g) - 4)))));
+  return down(2 / up(g + up(sqrt_rn(up(up(g * g) - 4)))));
 }
 double corner_mu_upper(const Corner& c) {
   const double g = down(down(c.a->sq_lo + c.b->sq_lo) / c.cross_hi);
-  return std::min(1.0, up(2 / down(g + down(std::sqrt(std::max(0.0, down(down(g * g) - 4)))))));
+  return std::min(1.0, up(2 / down(g + down(sqrt_rn(std::max(0.0, down(down(g * g) - 4)))))));
 }
 
 std::optional<QualityBounds> within(QualityBounds out, double tol) {
@@ -152,15 +153,15 @@ std::optional<QualityBounds> bilinear_quad_mu_bounds(const ElementType& type, st
   QualityBounds out{r_lo, upper, 0, false};
   if (quad.curved()) {
     if (least == nullptr) return std::nullopt;
-    const double eps = up(std::sqrt(up(up(quad.beta[0] * quad.beta[0]) + up(quad.beta[1] * quad.beta[1]))));
-    const double s = down(std::sqrt(quad.j_lo()));
+    const double eps = up(sqrt_rn(up(up(quad.beta[0] * quad.beta[0]) + up(quad.beta[1] * quad.beta[1]))));
+    const double s = down(sqrt_rn(quad.j_lo()));
     out.lower = down(down(down(r_lo * s) - eps) / up(s + eps));
     // At the least corner (columns a / 2, b / 2): sigma_max^2 = (t + sqrt(t^2 - 4 p^2)) / 2
     // with t = |c_1|^2 + |c_2|^2 and p = J_1, and sigma_min = p / sigma_max.
     const double t_lo = down(down(least->a->sq_lo + least->b->sq_lo) / 4), p_hi = up(least->cross_hi / 4);
     const double p_lo = down(least->cross_lo / 4);
     const double disc = std::max(0.0, down(down(t_lo * t_lo) - up(4 * up(p_hi * p_hi))));
-    const double max_lo = down(std::sqrt(down(down(t_lo + down(std::sqrt(disc))) / 2)));
+    const double max_lo = down(sqrt_rn(down(down(t_lo + down(sqrt_rn(disc))) / 2)));
     const double min_hi = up(p_hi / max_lo);
     if (!(max_lo > eps) || !(p_lo > 0)) return std::nullopt;
     out.upper = std::min(1.0, up(up(min_hi + eps) / down(max_lo - eps)));

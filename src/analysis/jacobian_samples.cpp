@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "analysis/sqrt_rn.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -37,7 +38,7 @@ std::array<double, 3> cross(const std::array<double, 3>& a, const std::array<dou
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 std::array<double, 3> unit(const std::array<double, 3>& v) {
-  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  const double n = sqrt_rn(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   if (!(n > 0) || !std::isfinite(n)) return {0, 0, 0};
   return {v[0] / n, v[1] / n, v[2] / n};
 }

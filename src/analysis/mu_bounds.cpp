@@ -19,6 +19,7 @@
 #include "analysis/mu_metric.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/error.hpp"
@@ -98,8 +99,8 @@ double element_w(const MuSpace& space, std::span<const double> x, double* w) {
   return rounding_gamma(n + dim + 9) * worst * range * (1 + 1e-12);
 }
 
-double sqrt_down(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_down(std::sqrt(r))); }
-double sqrt_up(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_up(std::sqrt(r))); }
+double sqrt_down(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_down(sqrt_rn(r))); }
+double sqrt_up(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_up(sqrt_rn(r))); }
 
 bool handled_family(ElementFamily f) {
   switch (f) {
@@ -252,11 +253,11 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
 
   const auto tol_r = [&] {
     // mu = sqrt(R): a bracket of width abs_tol * mu / 2 in R is about abs_tol / 4 in mu.
-    return 0.5 * options.abs_tol * std::max(std::sqrt(std::max(r_upper, 0.0)), options.abs_tol);
+    return 0.5 * options.abs_tol * std::max(sqrt_rn(std::max(r_upper, 0.0)), options.abs_tol);
   };
   // A lower bound of R above (sqrt(R upper) - 0.9 abs_tol)^2 meets the tolerance.
   const auto r_target = [&] {
-    const double m = std::sqrt(std::max(r_upper, 0.0)) - 0.9 * options.abs_tol;
+    const double m = sqrt_rn(std::max(r_upper, 0.0)) - 0.9 * options.abs_tol;
     return m <= 0 ? 0.0 : m * m;
   };
   // Per subdomain: the control-matrix bound (mu_control_bound.hpp), which converges like

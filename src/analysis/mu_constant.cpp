@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 
 namespace quadval {
 namespace {
@@ -110,7 +111,7 @@ bool eigenvector3(const double* m, double lambda, double* v) {
   const double rows = r0.squaredNorm() + r1.squaredNorm() + r2.squaredNorm();
   if (!(n2 > 1e-16 * rows * rows) || !std::isfinite(n2)) return false;
   Eigen::Map<Eigen::Vector3d> out(v);
-  out = c[best] / std::sqrt(n2);
+  out = c[best] / sqrt_rn(n2);
   return true;
 }
 

@@ -15,6 +15,7 @@
 
 #include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "quadval/bezier_basis.hpp"
 
 namespace quadval {
@@ -56,8 +57,8 @@ EigenEnclosure symmetric_eigen_enclosure<2>(const double* m, double err) {
   const double rt = err;
   const double s_hi = next_up(std::abs(s) + rq), s_lo = std::max(0.0, next_down(std::abs(s) - rq));
   const double t_hi = next_up(std::abs(t) + rt), t_lo = std::max(0.0, next_down(std::abs(t) - rt));
-  const double d_hi = next_up(std::sqrt(next_up(next_up(s_hi * s_hi) + next_up(t_hi * t_hi))));
-  const double d_lo = std::max(0.0, next_down(std::sqrt(std::max(0.0, next_down(next_down(s_lo * s_lo) + next_down(t_lo * t_lo))))));
+  const double d_hi = next_up(sqrt_rn(next_up(next_up(s_hi * s_hi) + next_up(t_hi * t_hi))));
+  const double d_lo = std::max(0.0, next_down(sqrt_rn(std::max(0.0, next_down(next_down(s_lo * s_lo) + next_down(t_lo * t_lo))))));
   const double q_lo = next_down(q - rq), q_hi = next_up(q + rq);
   if (!std::isfinite(q_lo) || !std::isfinite(q_hi) || !std::isfinite(d_hi)) return unknown();
   return {next_down(q_lo - d_hi), next_up(q_hi - d_lo), next_down(q_lo + d_lo), next_up(q_hi + d_hi)};
@@ -148,7 +149,7 @@ bool ratio_at_least3(const double* m, double err, double r) {
   const double sq = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (m[3] * m[3] + m[4] * m[4] + m[5] * m[5]);
   if (!std::isfinite(sq)) return false;
   // sq within 8u relative of tr((m - c I)^2) (sums of squares of once-rounded terms).
-  const double spread = next_up(std::sqrt(next_up(sq * (2.0 / 3.0) * (1 + 16 * u))));
+  const double spread = next_up(sqrt_rn(next_up(sq * (2.0 / 3.0) * (1 + 16 * u))));
   const double t = next_up(next_up(next_up(c + shift) + spread) + next_up(3 * err * (1 + 1e-15)));
   const double sa = next_up(next_up(r * t) + next_up(3 * err * (1 + 1e-15)));
   const double s[6] = {next_down(m[0] - sa), next_down(m[1] - sa), next_down(m[2] - sa), m[3], m[4], m[5]};
@@ -239,7 +240,7 @@ L8 enclosure_ratio_lower2_lanes(const L8* m, double err) {
 // 1 / sqrt(1 + c) (the top two eigenvalues nearly equal); the caller polishes the
 // eigenvalues and certifies them whatever their accuracy.
 double trisected_cosine(double c) {
-  const double s = std::sqrt(0.5 * (1 + c));
+  const double s = sqrt_rn(0.5 * (1 + c));
   double x = 0x1.2d945fe635cc5p-10;
   for (const double a : {-0x1.945b176bae327p-8, 0x1.08c20eb3ca04dp-6, -0x1.f0a66ec75bf0ap-6, 0x1.b11a9b6a6b367p-5,
                          -0x1.c6d5485f6740bp-4, 0x1.279a0e23f9291p-1, 0x1.000000c367160p-1})
@@ -261,15 +262,15 @@ bool extreme_eigen_bounds3(const double* m, double err, double& min_lo, double& 
   const double d0 = m[0] - q, d1 = m[1] - q, d2 = m[2] - q;
   const double off = m[3] * m[3] + m[4] * m[4] + m[5] * m[5];
   const double p2 = (d0 * d0 + d1 * d1 + d2 * d2 + 2 * off) / 6;
-  const double scale = std::abs(q) + 2 * std::sqrt(p2);
+  const double scale = std::abs(q) + 2 * sqrt_rn(p2);
   if (!std::isfinite(scale) || !(scale > 0)) return false;
   double y_min = 0, y_max = 0;
   if (p2 > 1e-30 * q * q) {
-    const double p = std::sqrt(p2);
+    const double p = sqrt_rn(p2);
     const double e3 = d0 * (d1 * d2 - m[5] * m[5]) - m[3] * (m[3] * d2 - m[5] * m[4]) + m[4] * (m[3] * m[5] - d1 * m[4]);
     const double c = std::clamp(e3 / (2 * p2 * p), -1.0, 1.0);
     const double ct = trisected_cosine(c);
-    const double st = std::sqrt((1 - ct) * (1 + ct));
+    const double st = sqrt_rn((1 - ct) * (1 + ct));
     y_max = 2 * p * ct;
     y_min = 2 * p * (-0.5 * ct - 0.8660254037844386 * st);  // cos(theta + 2 pi / 3)
     // One Newton step each on y^3 - 3 p^2 y - e3 (accuracy only, not soundness).

@@ -20,6 +20,7 @@
 #include "analysis/lane_vector.hpp"
 #include "analysis/mu_control_bound.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -176,7 +177,7 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
     if (rho == kInf) {
       r = 1;
     } else if (rho > 1) {
-      const double a = next_down(std::sqrt(rho));
+      const double a = next_down(sqrt_rn(rho));
       r = std::max(0.0, next_down(next_down(a - 1) / next_up(a + 1)));
     }
     return std::max(r_lo, std::min(r, 1.0));
@@ -197,7 +198,7 @@ double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, 
     if (rho == kInf) {
       lo = std::max(lo, next_down(1.0));
     } else if (rho > 1) {
-      const double a = next_down(std::sqrt(rho));
+      const double a = next_down(sqrt_rn(rho));
       const double cheap = next_down(1 - next_up(3.4641016151377553 / next_down(a + 1)));
       lo = std::max(lo, cheap);
     }
@@ -319,7 +320,7 @@ void MuMetric::make_p_upper() {
       const double v = std::abs(comp[k]->c[i]) + comp[k]->err;
       sum += (k < 3 ? 1.0 : 2.0) * v * v;
     }
-    pu_.c[i] = next_up(std::sqrt(sum * (1 + 1e-13) / 6));
+    pu_.c[i] = next_up(sqrt_rn(sum * (1 + 1e-13) / 6));
   }
   pu_.err = 0;
   pu_.mag = max_abs(pu_.c);
@@ -344,8 +345,8 @@ bool MuMetric::certify_filter(double r) {
   for (std::size_t i = 0; i < na; ++i) {
     const double a = std::max(2 * pu3_.c[i] - e3_.c[i], 1e-300);
     const double b = std::max(2 * pu3_.c[i] + e3_.c[i], 1e-300);
-    const double slack = a0 * q3_.c[i] + a1 * qp2_.c[i] + a2 * e3_.c[i] - 2 * k * std::sqrt(a * b);
-    if (slack < worst) worst = slack, lambda = std::sqrt(b / a);
+    const double slack = a0 * q3_.c[i] + a1 * qp2_.c[i] + a2 * e3_.c[i] - 2 * k * sqrt_rn(a * b);
+    if (slack < worst) worst = slack, lambda = sqrt_rn(b / a);
   }
   lambda = std::clamp(lambda, 1e-4, 1e4);
   const double c1 = 2 * k * (lambda + 1 / lambda);

@@ -15,6 +15,7 @@
 #include "analysis/factor_shapes.hpp"
 #include "analysis/product_tables.hpp"
 #include "analysis/pyramid_space.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "analysis/type_cache.hpp"
 #include "bezier/bezier_exact.hpp"
 #include "bezier/rational_rounding.hpp"
@@ -117,17 +118,17 @@ Matrix elevation_matrix(int d, int m) {
 }
 
 std::array<double, 9> ideal_inverse_of(ElementFamily f) {
-  const double r3 = 1 / std::sqrt(3.0), r6 = 1 / std::sqrt(6.0);
+  const double r3 = 1 / sqrt_rn(3.0), r6 = 1 / sqrt_rn(6.0);
   switch (f) {
-    case ElementFamily::triangle: return {1, -r3, 0, 0, 2 / std::sqrt(3.0), 0, 0, 0, 0};
+    case ElementFamily::triangle: return {1, -r3, 0, 0, 2 / sqrt_rn(3.0), 0, 0, 0, 0};
     case ElementFamily::tetrahedron:
-      return {1, -r3, -r6, 0, 2 / std::sqrt(3.0), -r6, 0, 0, std::sqrt(1.5)};
-    case ElementFamily::prism: return {1, -r3, 0, 0, 2 / std::sqrt(3.0), 0, 0, 0, 2};
+      return {1, -r3, -r6, 0, 2 / sqrt_rn(3.0), -r6, 0, 0, sqrt_rn(1.5)};
+    case ElementFamily::prism: return {1, -r3, 0, 0, 2 / sqrt_rn(3.0), 0, 0, 0, 2};
     case ElementFamily::quadrangle: return {1, 0, 0, 0, 1, 0, 0, 0, 0};
     case ElementFamily::hexahedron: return {1, 0, 0, 0, 1, 0, 0, 0, 1};
     // Gmsh's pyramid (base [-1,1]^2, apex (0,0,1)) to the ideal one (unit square base,
     // apex height 1/sqrt 2) is affine, J_i = diag(1/2, 1/2, 1/sqrt 2); scaled by 1/2.
-    case ElementFamily::pyramid: return {1, 0, 0, 0, 1, 0, 0, 0, 1 / std::sqrt(2.0)};
+    case ElementFamily::pyramid: return {1, 0, 0, 0, 1, 0, 0, 0, 1 / sqrt_rn(2.0)};
     default: return {};
   }
 }

@@ -19,10 +19,12 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/lane_vector.hpp"
 #include "analysis/linear_jacobian.hpp"
+#include "analysis/linear_pyramid_sj.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/ratio_scan.hpp"
 #include "analysis/scaled_jacobian_quotient.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/trilinear_hex_sj.hpp"
 #include "bezier/bernstein_bisection.hpp"
@@ -119,7 +121,7 @@ class Bounder {
         } else {
           double r = scan.extreme;
           r = r > 0 ? down(down(r * (1 - 4 * kUnit)) - std::numeric_limits<double>::denorm_min()) : 0;
-          frame_lower[t] = down(space_.s_lo() * down(std::sqrt(std::max(0.0, r))));
+          frame_lower[t] = down(space_.s_lo() * down(sqrt_rn(std::max(0.0, r))));
         }
         out = std::min(out, frame_lower[t]);
       }
@@ -136,7 +138,7 @@ class Bounder {
       // sj_k >= -s |v_b x v_c| / (|v_b| |v_c|) = -s sqrt(H_k / G_k) wherever v_a != 0
       // (and sj = 0 where it vanishes): sharp around a point of a fold where v_a = 0.
       if (lf.width[t] == 3) ratio = std::min(ratio, max_ratio(d + size_, err[q + 1], d + 2 * size_, err[q + 2]));
-      double best = -up(space_.s_hi() * up(std::sqrt(ratio)));
+      double best = -up(space_.s_hi() * up(sqrt_rn(ratio)));
       // Where sj_k = s J / sqrt(D_k): sj_k >= 0 where J >= 0, and where J < 0, J >= J_lo
       // (the least coefficient of J, convex hull) and sqrt(D_k) >= sqrt(D_k,lo), so
       // sj_k >= s J_lo / sqrt(D_k,lo). Unlike the bound from N = J^2, it does not count
@@ -149,7 +151,7 @@ class Bounder {
           best = 0;
         } else {
           const double d_lo = down(least(d) - ed);
-          if (d_lo > 0) best = std::max(best, -up(space_.s_hi() * up(-j_lo / down(std::sqrt(d_lo)))));
+          if (d_lo > 0) best = std::max(best, -up(space_.s_hi() * up(-j_lo / down(sqrt_rn(d_lo)))));
         }
       }
       frame_lower[t] = best;
@@ -159,7 +161,7 @@ class Bounder {
   }
 
   // The value lower() takes where neither J > 0 nor a bound on N / D_k is proven.
-  double floor() const { return -up(space_.s_hi() * up(std::sqrt(1.0))); }
+  double floor() const { return -up(space_.s_hi() * up(sqrt_rn(1.0))); }
 
   // True when no subdomain inside this one can ever get a lower bound above floor():
   // (1) at one of its vertices J <= 0 is certified, so every subdomain holding that vertex
@@ -195,7 +197,7 @@ class Bounder {
         const double d_lo = down(v[q * size_ + i] - err[q]);
         if (!(d_lo > 0)) continue;
         const double r = up(std::max(0.0, up(nv + err[n_])) / d_lo);
-        val = std::min(val, up(space_.s_hi() * up(std::sqrt(r))));
+        val = std::min(val, up(space_.s_hi() * up(sqrt_rn(r))));
       }
       return val;
     }
@@ -204,7 +206,7 @@ class Bounder {
     for (std::size_t t = 0; t < lf.count; q += lf.width[t], ++t) {
       const double d_hi = up(v[q * size_ + i] + err[q]);
       const double r = down(std::max(0.0, down(nv - err[n_])) / d_hi);
-      val = std::min(val, -down(space_.s_lo() * down(std::sqrt(r))));
+      val = std::min(val, -down(space_.s_lo() * down(sqrt_rn(r))));
     }
     return val;
   }
@@ -494,7 +496,7 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
         for (std::size_t k = 0; k < 3; ++k) v[k] += fr[j][c] * a[c][k];
         e += beta[c] + 4 * kUnit * a_norm1[c];
       }
-      const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      const double norm = sqrt_rn(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
       if (!(norm >= kSmall && norm <= kLarge && e <= 0.5 * norm)) return std::nullopt;
       den_hi *= norm + e;
       den_lo *= norm - e;
@@ -557,6 +559,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
       if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
     if (use_straight_path && type.family == ElementFamily::hexahedron && type.num_nodes == 8)
       if (const auto hex = trilinear_hex_sj_bounds(nodes, options.abs_tol)) return *hex;
+    if (use_straight_path && type.family == ElementFamily::pyramid && type.num_nodes == 5)
+      if (const auto pyramid = linear_pyramid_sj_bounds(space, nodes, options.abs_tol)) return *pyramid;
   }
   thread_local Polys polys;
   const bool area = dim == 2 && !planar;  // N = |c_1 x c_2|^2 rather than J^2

@@ -11,6 +11,7 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/error.hpp"
 
@@ -229,7 +230,7 @@ class Quotient {
     for (const auto& fr : layout_.frames) {
       double norm_product = 1;
       for (std::size_t j = 0; j < dim_; ++j)
-        norm_product = up(norm_product * up(up(std::sqrt(ws_.big[fr[j]]) * (1 + 1e-12)) + ws_.spread[fr[j]]));
+        norm_product = up(norm_product * up(up(sqrt_rn(ws_.big[fr[j]]) * (1 + 1e-12)) + ws_.spread[fr[j]]));
       // J > 0 on the element: sj > 0 everywhere, the bound where J_lo is not positive.
       lower = std::min(lower, j_lo > 0 ? down(space_.s_lo() * down(j_lo / norm_product)) : 0.0);
       // The corner of least sj estimated from the squares (any corner gives a true upper
@@ -252,7 +253,7 @@ class Quotient {
       if (best == corners) continue;
       double denominator = 1;
       for (std::size_t j = 0; j < dim_; ++j) {
-        const double norm_lo = down(down(std::sqrt(square_at(j, best)) * (1 - 1e-12)) - ws_.spread[fr[j]]);
+        const double norm_lo = down(down(sqrt_rn(square_at(j, best)) * (1 - 1e-12)) - ws_.spread[fr[j]]);
         denominator = norm_lo > 0 ? down(denominator * norm_lo) : 0;
       }
       if (!(denominator > 0)) continue;  // a column may vanish there: no value from this corner

@@ -9,6 +9,7 @@
 #include "analysis/jacobian_product.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
 #include "analysis/type_cache.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
@@ -181,8 +182,8 @@ ScaledJacobianSpace::ScaledJacobianSpace(const ElementType& type)
   }
 
   double s = 1;
-  if (type.family == ElementFamily::triangle || type.family == ElementFamily::prism) s = 2 / std::sqrt(3.0);
-  if (type.family == ElementFamily::tetrahedron) s = std::sqrt(2.0);
+  if (type.family == ElementFamily::triangle || type.family == ElementFamily::prism) s = 2 / sqrt_rn(3.0);
+  if (type.family == ElementFamily::tetrahedron) s = sqrt_rn(2.0);
   // Two roundings (sqrt, division): two ulps each way enclose the exact value.
   s_lo_ = s == 1 ? 1 : next_down(next_down(s));
   s_hi_ = s == 1 ? 1 : next_up(next_up(s));
@@ -200,8 +201,8 @@ void ScaledJacobianSpace::init_pyramid() {
     col_row_sum_[c] = next_up(maps.row_sum[c]);
   }
   // At the ideal pyramid each corner frame has |V| / prod |v_j| = 1 / sqrt 2.
-  s_lo_ = next_down(next_down(std::sqrt(2.0)));
-  s_hi_ = next_up(next_up(std::sqrt(2.0)));
+  s_lo_ = next_down(next_down(sqrt_rn(2.0)));
+  s_hi_ = next_up(next_up(sqrt_rn(2.0)));
 }
 
 const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type) {

@@ -89,8 +89,9 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
 /// Tests only: switch off (on by default), in the calling thread, the closed-form bounds of
 /// valid straight-sided simplices (planar triangles, tetrahedra: columns within the
 /// straight_sided.hpp margins of their edges) and of valid bilinear planar quadrangles
-/// (bilinear_quad_quality.hpp), and the root bound of valid first-order hexahedra
-/// (trilinear_hex_sj.hpp), to compare them with the general path.
+/// (bilinear_quad_quality.hpp), and the root bounds of valid first-order hexahedra and
+/// pyramids (trilinear_hex_sj.hpp, linear_pyramid_sj.hpp), to compare them with the
+/// general path.
 void scaled_jacobian_use_straight_path(bool on) noexcept;
 
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian

@@ -20,6 +20,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/scaled_jacobian_quotient.cpp
   src/analysis/bilinear_quad_quality.cpp
   src/analysis/trilinear_hex_sj.cpp
+  src/analysis/linear_pyramid_sj.cpp
   src/analysis/scaled_jacobian.cpp
   src/analysis/mu_space.cpp
   src/analysis/mu_metric.cpp

@@ -8,6 +8,7 @@
 
 #include "analysis/outward_rounding.hpp"
 #include "analysis/ratio_scan.hpp"
+#include "analysis/sqrt_rn.hpp"
 
 namespace quadval {
 namespace {
@@ -162,7 +163,7 @@ std::optional<QualityBounds> trilinear_hex_sj_bounds(std::span<const double> x, 
                           ? down(down(scan.extreme * (1 - 4 * kUnit)) - std::numeric_limits<double>::denorm_min())
                           : 0.0;
   QualityBounds out;
-  out.lower = r_lo > 0 ? down(std::sqrt(r_lo)) : 0.0;
+  out.lower = r_lo > 0 ? down(sqrt_rn(r_lo)) : 0.0;
   // Upper: sj at the corners, where the columns are the three edges there.
   out.upper = 1;  // Hadamard
   for (int a = 0; a < 2; ++a)
@@ -173,7 +174,7 @@ std::optional<QualityBounds> trilinear_hex_sj_bounds(std::span<const double> x, 
         const Vec& u3 = e3[a][b];
         double t = 0;
         const double j = det(u1, u2, u3, t);
-        const double den = down(std::sqrt(dot(u1, u1)) * std::sqrt(dot(u2, u2)) * std::sqrt(dot(u3, u3)) * (1 - 1e-12));
+        const double den = down(sqrt_rn(dot(u1, u1)) * sqrt_rn(dot(u2, u2)) * sqrt_rn(dot(u3, u3)) * (1 - 1e-12));
         if (den > 0) out.upper = std::min(out.upper, up(up(j + widen(16 * kUnit * t)) / den));
       }
   out.tolerance_met = up(out.upper - out.lower) <= tol;

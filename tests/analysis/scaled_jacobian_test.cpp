@@ -18,6 +18,7 @@
 #include "quadval/lagrange_basis.hpp"
 #include "quadval/scaled_jacobian.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "analysis/linear_pyramid_sj.hpp"
 #include "analysis/trilinear_hex_sj.hpp"
 
 namespace quadval {
@@ -447,6 +448,68 @@ TEST(ScaledJacobian, FirstOrderHexahedronRootBoundHoldsTheMinimum) {
   }
   EXPECT_GE(checked, 200);
   EXPECT_GE(settled, checked * 3 / 4);
+}
+
+// The pointwise scaled Jacobian of a pyramid by its definition (scaled_jacobian.hpp): J_p
+// from the Lagrange gradients at a reference point, the four base-corner frames E_k (half
+// base edges to the next and previous vertex, the edge to the apex, det E_k = 1).
+double pyramid_sj_at(const std::vector<double>& x, const RefPoint& p) {
+  const ElementType& t = *find_element_type(ElementFamily::pyramid, 1, true);
+  const LagrangeBasis& lb = lagrange_basis(t);
+  std::vector<double> g(static_cast<std::size_t>(3 * lb.num_nodes()));
+  lb.evaluate_gradients(p, g);
+  std::array<Vec, 3> c{};
+  for (int i = 0; i < lb.num_nodes(); ++i)
+    for (std::size_t d = 0; d < 3; ++d)
+      for (std::size_t j = 0; j < 3; ++j) c[d][j] += g[3 * static_cast<std::size_t>(i) + d] * x[3 * static_cast<std::size_t>(i) + j];
+  const double base[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  double worst = INFINITY;
+  for (int k = 0; k < 4; ++k) {
+    const double* v = base[k];
+    const double* next = base[(k + 1) % 4];
+    const double* prev = base[(k + 3) % 4];
+    Vec e[3] = {{(next[0] - v[0]) / 2, (next[1] - v[1]) / 2, 0}, {(prev[0] - v[0]) / 2, (prev[1] - v[1]) / 2, 0}, {-v[0], -v[1], 1}};
+    if (dot(e[0], cross(e[1], e[2])) < 0) std::swap(e[0], e[1]);
+    Vec w[3];
+    for (std::size_t j = 0; j < 3; ++j) w[j] = combo(c, e[j]);
+    worst = std::min(worst, std::sqrt(2.0) * dot(w[0], cross(w[1], w[2])) / (norm(w[0]) * norm(w[1]) * norm(w[2])));
+  }
+  return worst;
+}
+
+// The fixed-size first stage of valid first-order pyramids (linear_pyramid_sj.hpp) against
+// the definition at dense points and the general path (at 1e-6): never above a sampled
+// value nor the general upper bound, its upper bound never below the general lower one; and
+// it settles at the default tolerance every element the general first stage settles
+// without splitting (the same bound, but for its rounding margins).
+TEST(ScaledJacobian, FirstOrderPyramidFirstStageHoldsTheMinimum) {
+  std::mt19937 rng(61);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const ElementType& t = type_of(ElementFamily::pyramid, 1);
+  const ScaledJacobianSpace& space = scaled_jacobian_space(t);
+  const auto points = test::dense_points(t.family, 10, 300, rng);
+  int checked = 0, settled = 0;
+  for (int e = 0; e < 300; ++e) {
+    const double scale = std::pow(10.0, 2 * u(rng)), amplitude = e % 3 == 0 ? 0.02 : 0.2;
+    const Vec shift = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
+    std::vector<double> x;
+    for (const RefPoint& p : reference_nodes(t))
+      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + amplitude * u(rng)) + shift[j]);
+    double sampled = INFINITY;
+    for (const RefPoint& p : points) sampled = std::min(sampled, pyramid_sj_at(x, p));
+    if (!(sampled > 0.05)) continue;  // invalid or nearly so: not this path's case
+    const auto first = linear_pyramid_sj_bounds(space, x, 1.0);
+    ASSERT_TRUE(first.has_value()) << "element " << e;
+    EXPECT_LE(first->lower, sampled + 1e-12) << "element " << e;
+    expect_overlaps_general_path(t, x, *first);
+    if (scaled_jacobian_quotient_stage(t, x, false, 1e-2, 0).tolerance_met) {
+      EXPECT_TRUE(linear_pyramid_sj_bounds(space, x, 1e-2 * (1 + 1e-6)).has_value()) << "element " << e;
+      ++settled;
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 200);
+  EXPECT_GE(settled, 20);
 }
 
 // The first stage's bounds `stage` of element e enclose sj(E): lower <= upper, lower never
