@@ -65,6 +65,10 @@ struct Quad {
     e[1] = edge(x, 2, 3);
     f[0] = edge(x, 3, 0);
     f[1] = edge(x, 2, 1);
+    // Norms within [2^-400, 2^400]: their squares are normal numbers, within the relative
+    // error bounds of `edge`.
+    for (const Edge* g : {&e[0], &e[1], &f[0], &f[1]})
+      if (!(g->norm_lo >= 0x1p-400 && g->norm_hi <= 0x1p400)) return false;
     // Corners 0..3 of Gmsh's quadrangle: (xi, eta) = (-1, -1), (1, -1), (1, 1), (-1, 1).
     constexpr int kE[4] = {0, 0, 1, 1}, kF[4] = {0, 1, 1, 0};
     for (std::size_t k = 0; k < 4; ++k) {
@@ -72,7 +76,7 @@ struct Quad {
       c.a = &e[kE[k]];
       c.b = &f[kF[k]];
       const double p = c.a->x * c.b->y, q = c.a->y * c.b->x;
-      const double err = up(8 * kUnit * up(std::abs(p) + std::abs(q)));
+      const double err = up(up(8 * kUnit * up(std::abs(p) + std::abs(q))) + 0x1p-1000);  // and gradual underflow
       c.cross_lo = down(p - q - err);
       c.cross_hi = up(up(p - q) + err);
       if (!(c.cross_lo > 0)) return false;  // J_1 not proven positive here

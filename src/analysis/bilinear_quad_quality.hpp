@@ -37,8 +37,9 @@
 //    least corner value and s = sqrt(J_lo) <= sigma_max,1 (the bound increases with
 //    sigma_max,1); at the corner of least value mu <= (sigma_min,1 + eps) / (sigma_max,1 - eps).
 // Rounding: an edge's coordinates are one difference each (relative u), a corner's cross
-// product is within 8u (|a_x b_y| + |a_y b_x|) of the exact one, norms and squared norms
-// within 1e-12 relative; every later step is rounded outward.
+// product is within 8u (|a_x b_y| + |a_y b_x|) + 2^-1000 (gradual underflow) of the exact
+// one, norms (kept within [2^-400, 2^400]) and squared norms within 1e-12 relative; every
+// later step is rounded outward.
 
 #include <optional>
 #include <span>

@@ -73,7 +73,7 @@ std::optional<QualityBounds> linear_pyramid_sj_bounds(const ScaledJacobianSpace&
           det_max = std::max(det_max, std::abs(d));
           jac[i + i2][j + j2] += kW1[i][i2] * kW1[j][j2] * d;
         }
-  j_err = next_up((j_err + gamma(4) * det_max) * (1 + 1e-12));
+  j_err = next_up((j_err + gamma(4) * det_max) * (1 + 1e-12) + 0x1p-1000);  // 2^-1000: gradual underflow
   double j_min = kInf;
   for (const auto& row : jac)
     for (double v : row) j_min = std::min(j_min, v);

@@ -23,7 +23,7 @@
 // its own rounding, 2u of at most 3 sqrt(3) L); a determinant of control points a, b, c
 // within 16u T (T the sum of its triple products' magnitudes) + 2e' (|a||b| + |b||c| +
 // |c||a|) + 2e'^2 (|a| + |b| + |c|) + 4e'^3, e' = 3e bounding a vector's error (1-norms
-// throughout); J within that plus gamma_4 of its terms. A norm is used only where it is at
+// throughout); J within that plus gamma_4 of its terms and 2^-1000 (gradual underflow). A norm is used only where it is at
 // least twice its error, so the differences below lose at most 2u relative; positive
 // quantities are then combined in plain arithmetic (fewer than 20 roundings) and widened
 // once by 1e-11 relative.

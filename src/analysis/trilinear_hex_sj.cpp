@@ -14,12 +14,15 @@ namespace quadval {
 namespace {
 
 constexpr double kUnit = 0x1p-53;
-constexpr double kInf = std::numeric_limits<double>::infinity();
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
 constexpr double gamma(int n) { return n * kUnit / (1 - n * kUnit); }
-// A bound widened to cover the rounding of its own computation.
-double widen(double e) { return up(e * (1 + 1e-12)); }
+// A bound widened to cover the rounding of its own computation, and 2^-1000 for gradual
+// underflow (which the relative error model above does not cover).
+double widen(double e) { return up(up(e * (1 + 1e-12)) + 0x1p-1000); }
+// Edges of 1-norm within [2^-100, 2^100]: every norm, square and product of six of them is
+// a normal number.
+constexpr double kSmall = 0x1p-100, kLarge = 0x1p100;
 
 using Vec = std::array<double, 3>;
 
@@ -76,7 +79,7 @@ std::optional<QualityBounds> trilinear_hex_sj_bounds(std::span<const double> x, 
   for (const auto* e : {&e1, &e2, &e3})
     for (const auto& row : *e)
       for (const Vec& v : row)
-        if (!std::isfinite(norm1(v))) return std::nullopt;
+        if (!(norm1(v) >= kSmall && norm1(v) <= kLarge)) return std::nullopt;
 
   // J: coefficient (p, q, r) gathers det[e1[b][c], e2[a][c'], e3[a'][b']] with p = a + a',
   // q = b + b', r = c + c'; each cross product e2 x e3 (and its terms' magnitudes, for T)

@@ -15,7 +15,8 @@
 // first-order hexahedra of a mesh are settled here at the default tolerance (hex_box: 99%);
 // the rest go on to the general path. Internal to src/analysis.
 //
-// Rounding (u = 2^-53), each bound rounded up and widened by 1e-12 relative:
+// Rounding (u = 2^-53), each bound rounded up, widened by 1e-12 relative and by 2^-1000 for
+// gradual underflow (the edges' 1-norms must lie in [2^-100, 2^100], else the general path):
 //  - an edge's coordinates: one difference each, within 1.01u of the exact ones;
 //  - a determinant, as e_1 . (e_2 x e_3): within 16u T, T the sum of the magnitudes of its
 //    six triple products (inputs 3.1u, the products and sums gamma_5);
