@@ -60,6 +60,9 @@
 ///   W's control values with their error bound): R >= the closed-form bound of one 2x2 or
 ///   3x3 metric (Gershgorin discs of V^T M V at approximate eigenvectors V, Ostrowski's
 ///   theorem for V's non-orthogonality; src/analysis/mu_constant.hpp), no subdivision.
+///   Bilinear quadrangles in a plane z = const (valid, order 1 or straight-sided): mu is
+///   least at a corner, so the corners' closed forms bound it, widened by the
+///   straight-sided margin (src/analysis/bilinear_quad_quality.hpp, which proves it).
 /// upper: the minimum over the corners of all subdomains of an upper bound of mu_pw there
 ///   (Rayleigh quotients of W at approximate eigenvectors of W^T W, enclosed in interval
 ///   fashion: lambda_min <= |W v|^2 / |v|^2 <= lambda_max for any v).

@@ -70,7 +70,12 @@
 /// their own degrees (convex hull), exact on straight-sided simplices and parallelepipeds;
 /// it settles the straight and barely curved elements that make up most of a curved mesh,
 /// and its bounds tighten the ones below when it does not (src/analysis/
-/// scaled_jacobian_quotient.hpp).
+/// scaled_jacobian_quotient.hpp). Before it, on valid elements, closed forms or fixed-size
+/// formulas: straight-sided simplices (the edges, widened by the straight-sided margin),
+/// bilinear quadrangles in a plane z = const (sj is least at a corner:
+/// src/analysis/bilinear_quad_quality.hpp), first-order hexahedra (the root's N / D bound:
+/// trilinear_hex_sj.hpp) and first-order pyramids (this first stage: linear_pyramid_sj.hpp);
+/// where they fall short of the tolerance, the general path follows.
 /// upper is the minimum of sj at points (the corners of the subdomains, where a Bézier
 /// coefficient is a value), rounded up by their error bounds. Refinement is best-first
 /// (the subdomain with the smallest lower bound is halved by one edge bisection,
