@@ -6,33 +6,25 @@
 #include <cmath>
 #include <limits>
 
+#include "analysis/edge_determinants.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/sqrt_rn.hpp"
+#include "quadval/bezier_basis.hpp"
 
 namespace quadval {
 namespace {
 
+using edge_determinants::det;
+using edge_determinants::kW1;
+using edge_determinants::norm1;
+using edge_determinants::Vec;
+
 constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kSlack = 1e-11, kSmall = 0x1p-200, kLarge = 0x1p200;
-constexpr double gamma(int n) { return n * kUnit / (1 - n * kUnit); }
 
-using Vec = std::array<double, 3>;
-
-// w1(i, j) = C(1,i) C(1,j) / C(2,i+j): the product of two degree-1 Bernstein polynomials.
-constexpr double kW1[2][2] = {{1, 0.5}, {0.5, 1}};
-
-double norm1(const Vec& v) { return std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2]); }
 Vec minus(const Vec& a, const Vec& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
 Vec half(const Vec& a) { return {a[0] / 2, a[1] / 2, a[2] / 2}; }
-
-// det[a, b, c] as a . (b x c), and T, the sum of its six triple products' magnitudes.
-double det(const Vec& a, const Vec& b, const Vec& c, double& t) {
-  t = std::abs(a[0]) * (std::abs(b[1] * c[2]) + std::abs(b[2] * c[1])) +
-      std::abs(a[1]) * (std::abs(b[2] * c[0]) + std::abs(b[0] * c[2])) +
-      std::abs(a[2]) * (std::abs(b[0] * c[1]) + std::abs(b[1] * c[0]));
-  return a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-}
 
 }  // namespace
 
@@ -73,7 +65,7 @@ std::optional<QualityBounds> linear_pyramid_sj_bounds(const ScaledJacobianSpace&
           det_max = std::max(det_max, std::abs(d));
           jac[i + i2][j + j2] += kW1[i][i2] * kW1[j][j2] * d;
         }
-  j_err = next_up((j_err + gamma(4) * det_max) * (1 + 1e-12) + 0x1p-1000);  // 2^-1000: gradual underflow
+  j_err = next_up((j_err + rounding_gamma(4) * det_max) * (1 + 1e-12) + 0x1p-1000);  // 2^-1000: gradual underflow
   double j_min = kInf;
   for (const auto& row : jac)
     for (double v : row) j_min = std::min(j_min, v);

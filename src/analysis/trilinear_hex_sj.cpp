@@ -6,17 +6,23 @@
 #include <cmath>
 #include <limits>
 
+#include "analysis/edge_determinants.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/ratio_scan.hpp"
 #include "analysis/sqrt_rn.hpp"
+#include "quadval/bezier_basis.hpp"
 
 namespace quadval {
 namespace {
 
+using edge_determinants::det;
+using edge_determinants::kW1;
+using edge_determinants::norm1;
+using edge_determinants::Vec;
+
 constexpr double kUnit = 0x1p-53;
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
-constexpr double gamma(int n) { return n * kUnit / (1 - n * kUnit); }
 // A bound widened to cover the rounding of its own computation, and 2^-1000 for gradual
 // underflow (which the relative error model above does not cover).
 double widen(double e) { return up(up(e * (1 + 1e-12)) + 0x1p-1000); }
@@ -24,24 +30,10 @@ double widen(double e) { return up(up(e * (1 + 1e-12)) + 0x1p-1000); }
 // a normal number.
 constexpr double kSmall = 0x1p-100, kLarge = 0x1p100;
 
-using Vec = std::array<double, 3>;
-
 // Gmsh's vertex at reference index (i, j, k) in {0, 1}^3 (0: -1, 1: +1).
 constexpr int kVertex[2][2][2] = {{{0, 4}, {3, 7}}, {{1, 5}, {2, 6}}};
 
-// w1(i, j) = C(1,i) C(1,j) / C(2,i+j): the product of two degree-1 Bernstein polynomials.
-constexpr double kW1[2][2] = {{1, 0.5}, {0.5, 1}};
-
-double norm1(const Vec& v) { return std::abs(v[0]) + std::abs(v[1]) + std::abs(v[2]); }
 double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
-
-// det[a, b, c] as a . (b x c), and T, the sum of its six triple products' magnitudes.
-double det(const Vec& a, const Vec& b, const Vec& c, double& t) {
-  t = std::abs(a[0]) * (std::abs(b[1] * c[2]) + std::abs(b[2] * c[1])) +
-      std::abs(a[1]) * (std::abs(b[2] * c[0]) + std::abs(b[0] * c[2])) +
-      std::abs(a[2]) * (std::abs(b[0] * c[1]) + std::abs(b[1] * c[0]));
-  return a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) + a[2] * (b[0] * c[1] - b[1] * c[0]);
-}
 
 // The squared norm |c|^2 of a bilinear column with control points e[i][j] (degree 2 per
 // axis, 9 coefficients s[i][j]); returns the error bound, `m` the largest magnitude.
@@ -57,7 +49,7 @@ double squared_norm(const Vec (&e)[2][2], double (&s)[3][3], double& m) {
   m = 0;
   for (const auto& row : s)
     for (double v : row) m = std::max(m, std::abs(v));
-  return widen((8 * kUnit + gamma(4)) * big * big);
+  return widen((8 * kUnit + rounding_gamma(4)) * big * big);
 }
 
 }  // namespace
@@ -104,7 +96,7 @@ std::optional<QualityBounds> trilinear_hex_sj_bounds(std::span<const double> x, 
               jac[a + a2][b + b2][c + c2] += kW1[a][a2] * kW1[b][b2] * kW1[c][c2] * d;
             }
         }
-  const double e_j = widen(16 * kUnit * t_max + gamma(8) * det_max);
+  const double e_j = widen(16 * kUnit * t_max + rounding_gamma(8) * det_max);
   double m_j = 0;
   for (const auto& plane : jac)
     for (const auto& row : plane)
@@ -151,9 +143,9 @@ std::optional<QualityBounds> trilinear_hex_sj_bounds(std::span<const double> x, 
         n[p][q][r] *= w;
         d[p][q][r] *= w;
       }
-  const double e_n = widen(e_j * m_j + (m_j + e_j) * e_j + gamma(40) * m_j * m_j);
+  const double e_n = widen(e_j * m_j + (m_j + e_j) * e_j + rounding_gamma(40) * m_j * m_j);
   const double e_d = widen(e1s * (m2 + e2s) * (m3 + e3s) + (m1 + e1s) * e2s * (m3 + e3s) +
-                           (m1 + e1s) * (m2 + e2s) * e3s + gamma(40) * m1 * m2 * m3);
+                           (m1 + e1s) * (m2 + e2s) * e3s + rounding_gamma(40) * m1 * m2 * m3);
   if (!std::isfinite(e_n) || !std::isfinite(e_d)) return std::nullopt;  // overflow
 
   // The relaxation: sj^2 >= min_i (N_i - e_n) / (D_i + e_d), every D_i - e_d > 0. Without
