@@ -283,19 +283,30 @@ void BernsteinProduct::build_grids() const {
   const auto make_grid = [&](const std::vector<FactorDegree>& deg, bool invert) {
     Grid grid;
     std::vector<std::vector<MultiIndex>> idx;
-    for (const FactorDegree& d : deg) idx.push_back(simplex_multi_indices(d.dim, d.degree));
+    // Per factor, each index's multinomial (0: beyond 128 bits), once: per cell they were
+    // recomputed and multiplied as reduced fractions, 128-bit divisions that made half of
+    // the set-up of a first scaled-Jacobian check (27-node hexahedron: 1.41 -> 0.72 ms).
+    std::vector<std::vector<U128>> mult;
+    for (const FactorDegree& d : deg) {
+      idx.push_back(simplex_multi_indices(d.dim, d.degree));
+      auto& m = mult.emplace_back();
+      for (const MultiIndex& a : idx.back()) m.push_back(multinomial128(a, d.dim));
+    }
     int size = 1;
     for (const auto& v : idx) size *= static_cast<int>(v.size());
     for (int i = 0; i < size; ++i) {
       int rest = i, c = 0;
       std::array<int, 3> pos{0, 0, 0};
-      Fraction alpha;
+      // alpha, the product of the factors' multinomials: an integer, exact in U128 unless
+      // a factor did not fit or the product overflows (then alpha = 0 and GMP below).
+      U128 alpha = 1;
       std::array<const MultiIndex*, 3> parts{};
       for (std::size_t f = 0; f < deg.size(); ++f) {
         const auto n = static_cast<int>(idx[f].size());
-        const MultiIndex& a = idx[f][static_cast<std::size_t>(rest % n)];
+        const auto at = static_cast<std::size_t>(rest % n);
+        const MultiIndex& a = idx[f][at];
         rest /= n;
-        alpha = times(alpha, ratio(multinomial128(a, deg[f].dim), 1));
+        if (__builtin_mul_overflow(alpha, mult[f][at], &alpha)) alpha = 0;
         parts[f] = &a;
         for (int k = 1; k <= deg[f].dim; ++k) pos[static_cast<std::size_t>(c++)] = a[static_cast<std::size_t>(k)];
       }
@@ -305,9 +316,9 @@ void BernsteinProduct::build_grids() const {
         return m;
       };
       grid.offset.push_back(pos[0] + hdims[0] * (pos[1] + hdims[1] * pos[2]));
-      grid.scale.push_back(invert ? nearest(alpha.den == 0 ? alpha : Fraction{alpha.den, alpha.num},
-                                            [&] { return mpq_class(mpz_class(1), exact_alpha()); })
-                                  : nearest(alpha, [&] { return mpq_class(exact_alpha()); }));
+      const Fraction w = alpha == 0 ? Fraction{0, 0} : invert ? Fraction{1, alpha} : Fraction{alpha, 1};
+      grid.scale.push_back(invert ? nearest(w, [&] { return mpq_class(mpz_class(1), exact_alpha()); })
+                                  : nearest(w, [&] { return mpq_class(exact_alpha()); }));
     }
     // Runs: the valid cells of a row are a prefix (an index sum <= n per simplex factor);
     // consecutive rows merge into one run while at least half of its cells are valid

@@ -173,6 +173,10 @@ TEST(MuBernsteinProduct, SumsOfProductsMatchExactCoefficients) {
       // longer ones cut into 8 + 2 (line factor of degree 9).
       {{{2, 7}}, {{2, 8}}},
       {{{1, 9}, {1, 2}}, {{1, 10}, {1, 3}}},
+      // Multinomials beyond 2^53 (the grid scales then rounded by GMP), beyond 128 bits
+      // (degree 150), and a product of two factors' multinomials beyond 128 bits.
+      {{{1, 146}}, {{1, 4}}},
+      {{{1, 120}, {1, 5}}, {{1, 4}, {1, 5}}},
   };
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> u(-1, 1);

@@ -16,6 +16,8 @@
 #include "analysis/midpoint_probe.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/product_tables.hpp"
+#include "analysis/scaled_jacobian_space.hpp"
+#include "quadval/scaled_jacobian.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "jacobian_test_util.hpp"
 
@@ -107,6 +109,28 @@ TEST(ProductTables, GeneratedMuTablesEqualExactlyBuiltBitForBit) {
     }
   }
   EXPECT_GE(count, 30);
+}
+
+// The scaled Jacobian's pyramid columns take mu's generated derivative maps where there are
+// some: bit for bit the exactly built column maps, for every pyramid order, generated or
+// not.
+TEST(ProductTables, PyramidScaledJacobianColumnsEqualExactMaps) {
+  int generated = 0;
+  for (const ElementType& type : element_types()) {
+    if (type.family != ElementFamily::pyramid || !scaled_jacobian_supported(type)) continue;
+    SCOPED_TRACE(std::string(type.name));
+    if (generated_mu_tables(type.gmsh_id) != nullptr) ++generated;
+    const PyramidColumnMaps exact = pyramid_column_maps(type);
+    const ScaledJacobianSpace& space = scaled_jacobian_space(type);
+    for (int c = 0; c < 3; ++c) {
+      const auto uc = static_cast<std::size_t>(c);
+      expect_same_bits(space.column_map(c), exact.map[uc], "column map " + std::to_string(c));
+      const double want_row_sum = std::nextafter(exact.row_sum[uc], INFINITY);
+      const double row_sum = space.column_row_sum(c);
+      expect_same_bits(std::span(&row_sum, 1), std::span(&want_row_sum, 1), "row sum");
+    }
+  }
+  EXPECT_GE(generated, 2);  // orders 1 and 2
 }
 
 TEST(ProductTables, GeneratedProbeTablesEqualBuiltOnesBitForBit) {
