@@ -323,13 +323,16 @@ void BernsteinProduct::build_grids() const {
     // Runs: the valid cells of a row are a prefix (an index sum <= n per simplex factor);
     // consecutive rows merge into one run while at least half of its cells are valid
     // (whole planes of tensor grids; row by row for simplices, mostly padding otherwise).
-    std::map<int, std::array<int, 2>> rows;  // row start offset -> (first, end) offsets
+    // Per row of h's grid, the (first, end) offsets of the grid's cells in it; {0, 0}: none
+    // (a vector, not a map: first 27-node hexahedron's scaled Jacobian 0.61 -> 0.52 ms).
+    std::vector<std::array<int, 2>> rows(static_cast<std::size_t>(h_cells_ / hdims[0]), std::array<int, 2>{0, 0});
     for (int off : grid.offset) {
-      auto [it, fresh] = rows.try_emplace(off - off % hdims[0], std::array<int, 2>{off, off + 1});
-      if (!fresh) it->second = {std::min(it->second[0], off), std::max(it->second[1], off + 1)};
+      auto& span = rows[static_cast<std::size_t>(off / hdims[0])];
+      span = span[1] == 0 ? std::array<int, 2>{off, off + 1} : std::array<int, 2>{std::min(span[0], off), std::max(span[1], off + 1)};
     }
     int valid = 0;
-    for (const auto& [row, span] : rows) {
+    for (const auto& span : rows) {
+      if (span[1] == 0) continue;
       if (!grid.runs.empty()) {
         auto& last = grid.runs.back();
         const int merged = span[1] - last[0];
