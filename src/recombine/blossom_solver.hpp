@@ -30,16 +30,20 @@
 // (3x slower), nor packing the per-vertex fields into one struct. An algorithm that augments
 // along many paths per dual adjustment (cost scaling) would be the remedy.
 //
-// Where the work goes on uniform-100k (event counts, one run): 692 augmentations, 7.39M
-// grows, 13.6M tree nodes dissolved, 280k shrinks and 262k expands (nearly all after the
-// 650th augmentation, which is reached at 70% of the time). Trees are very unequal: mid-run
-// a handful hold 10k-30k vertices each (at times one holds 96k of the 102k) while about
-// 1,000 hold 1-15; most augmentations pair two small trees, but every few an augmentation
-// takes a big one, and then one neighbouring tree regrows about 85% of its region at the
-// same dual value (multi-source breadth-first, yet the other sources touch it little). A
-// structure that let a neighbour inherit a dissolved tree's labels instead of regrowing them
-// (in a bipartite tight region the labels come back the same; only tree ids and parents
-// change) would remove most of the grows; it needs parents repaired or found lazily.
+// Where the work goes on uniform-100k (event counts of one run): 692 augmentations, 7.39M
+// grows, 13.6M tree nodes dissolved, 280k shrinks, 262k expands.
+// - Augmentations 100-300: a few trees of 5k-30k vertices beside about 1,000 of 1-15; when
+//   a big one augments, its region is regrown at the same dual value, 99.9% with the same
+//   labels, about 85% of it by one neighbouring tree.
+// - Augmentations 300-650 (5M of the grows): one tree covers 90k-96k vertices; each time it
+//   augments (with a tree of 3-5), the region stays free until, at a higher dual value,
+//   another tree reaches it and takes all of it again: about 50 such cycles.
+// - The last 42 augmentations (30% of the time): 264k shrinks and 248k expands of blossoms of
+//   10k-100k vertices (about 5 children each), deeply nested blossoms peeled one level per
+//   expand and wrapped again at the same dual value, about 2 us per event.
+// In a bipartite tight region the labels come back the same, only tree ids and parents
+// change: a structure that let a tree take over such a region without regrowing it (parents
+// repaired or found lazily) would remove most of the grows.
 //
 // Warm starts, measured on uniform-100k (all give the same optimum; none adopted):
 // - From the exact optimal duals of the fractional relaxation (the assignment problem of the
