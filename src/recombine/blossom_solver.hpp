@@ -38,9 +38,12 @@
 // - Augmentations 300-650 (5M of the grows): one tree covers 90k-96k vertices; each time it
 //   augments (with a tree of 3-5), the region stays free until, at a higher dual value,
 //   another tree reaches it and takes all of it again: about 50 such cycles.
-// - The last 42 augmentations (30% of the time): 264k shrinks and 248k expands of blossoms of
-//   10k-100k vertices (about 5 children each), deeply nested blossoms peeled one level per
-//   expand and wrapped again at the same dual value, about 2 us per event.
+// - The last 12 augmentations (30% of the time): about 20k shrinks and 20k expands each, of
+//   blossoms of 10k-100k vertices nested thousands deep (each level adds 2-12 vertices to
+//   the one inside). In a tree as "-", such a blossom is peeled one level per expand, each
+//   level at its own dual value (a dual step each), and built again level by level later;
+//   about 2 us per event. Expanding free blossoms whose dual is zero (the classic end-of-
+//   stage rule) changes nothing here: none are left when trees dissolve.
 // In a bipartite tight region the labels come back the same, only tree ids and parents
 // change: a structure that let a tree take over such a region without regrowing it (parents
 // repaired or found lazily) would remove most of the grows.
