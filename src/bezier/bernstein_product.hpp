@@ -58,6 +58,14 @@ class BernsteinProduct {
   /// squares (f_t == g_t, same pointer, in every term) in half the pairs;
   /// rounding(terms.size()) bounds the result as for repeated multiply_add.
   void multiply_add_sum(std::span<const Term> terms, double* h) const;
+  /// The Gram sums of a matrix polynomial W in one walk over the pairs: for each entry e =
+  /// (a, b) of W^T W, h[e] += sum_x w[3 a + x] * w[3 b + x] (w[3 a + x]: coordinate x of
+  /// column a, in this product's f space, which must equal its g space), with per entry
+  /// the arithmetic of multiply_add_sum on its three terms (scales 1) by the general pairs,
+  /// so rounding(3) bounds each. Entries (0,0), (1,1), (2,2), (0,1), (0,2), (1,2); with 2
+  /// columns (0,0), (1,1), (0,1). Returns false, adding nothing, without an entry kernel
+  /// (large products): then one multiply_add_sum per entry.
+  bool gram_sums(const double* const* w, int columns, double* const* h) const;
   /// Choose the per-factor weighted-entry loop (default for small products) or the scaled
   /// convolution (default for large ones); same product within rounding().
   void use_entry_kernel(bool on) noexcept { entries_kernel_ = on; }
@@ -94,6 +102,9 @@ class BernsteinProduct {
   template <std::size_t N>
   void fused_entries(std::span<const Term> terms, const std::vector<int>& row_start,
                      const std::vector<Pair>& pair_list, double* h) const;
+  // gram_sums for 2 or 3 columns.
+  template <int Columns>
+  void gram_entries(const double* const* w, double* const* h) const;
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at
   // most 3 coordinates), h_k = (sum_{i+j=k} f_i alpha_i g_j alpha_j) / alpha_k. Every

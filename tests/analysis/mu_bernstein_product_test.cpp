@@ -52,6 +52,12 @@ mpq_class evaluate(const std::vector<FactorDegree>& deg, const std::vector<doubl
   return sum;
 }
 
+double largest_abs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+
 struct Case {
   std::vector<FactorDegree> f, g;
 };
@@ -296,6 +302,57 @@ TEST(MuBernsteinProduct, EntryWeightsAreTheExactWeightsRounded) {
         ASSERT_EQ(h[m], nearest_double(want[m])) << "case " << &c - cases.data() << " i " << i << " j " << j;
     }
   }
+}
+
+// gram_sums (every entry of W^T W in one walk over the pairs, 8 lanes) against the three-term
+// sums of the general pair walk, entry by entry: bit for bit, since each lane does the same
+// roundings in the same order (diagonal entries through two copies of the column, so that
+// multiply_add_sum does not take its rows of squares). Also, against exact rationals,
+// within rounding(3).
+TEST(MuBernsteinProduct, GramSumsEqualThreeTermSumsBitForBit) {
+  const std::vector<std::vector<FactorDegree>> spaces{{{3, 2}}, {{2, 3}}, {{1, 2}, {1, 2}, {1, 2}}, {{2, 2}, {1, 2}}};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const auto& d : spaces)
+    for (const int columns : {2, 3}) {
+      SCOPED_TRACE(::testing::Message() << "space " << &d - spaces.data() << ", " << columns << " columns");
+      const BernsteinProduct& table = bernstein_product(d, d);
+      ASSERT_LT(static_cast<long>(table.f_size()) * table.f_size(), 2048);
+      std::vector<std::vector<double>> w(static_cast<std::size_t>(3 * columns), std::vector<double>(static_cast<std::size_t>(table.f_size())));
+      for (auto& c : w)
+        for (double& v : c) v = u(rng) * std::ldexp(1.0, static_cast<int>(4 * u(rng)));
+      const int entries = columns * (columns + 1) / 2;
+      const std::array<int, 6> ea = columns == 3 ? std::array<int, 6>{0, 1, 2, 0, 0, 1} : std::array<int, 6>{0, 1, 0};
+      const std::array<int, 6> eb = columns == 3 ? std::array<int, 6>{0, 1, 2, 1, 2, 2} : std::array<int, 6>{0, 1, 1};
+      std::vector<std::vector<double>> got(6, std::vector<double>(static_cast<std::size_t>(table.h_size()), 0.0));
+      const double* cols[9];
+      for (int c = 0; c < 3 * columns; ++c) cols[c] = w[static_cast<std::size_t>(c)].data();
+      double* out[6];
+      for (int e = 0; e < 6; ++e) out[e] = got[static_cast<std::size_t>(e)].data();
+      ASSERT_TRUE(table.gram_sums(cols, columns, out));
+      for (int e = 0; e < entries; ++e) {
+        const auto a = static_cast<std::size_t>(ea[static_cast<std::size_t>(e)]), b = static_cast<std::size_t>(eb[static_cast<std::size_t>(e)]);
+        std::vector<std::vector<double>> copies;  // column b's coordinates, as separate vectors
+        for (std::size_t x = 0; x < 3; ++x) copies.push_back(w[3 * b + x]);
+        std::vector<BernsteinProduct::Term> terms;
+        for (std::size_t x = 0; x < 3; ++x) terms.push_back({1.0, w[3 * a + x].data(), copies[x].data()});
+        std::vector<double> want(static_cast<std::size_t>(table.h_size()), 0.0);
+        table.multiply_add_sum(terms, want.data());
+        for (std::size_t k = 0; k < want.size(); ++k)
+          ASSERT_EQ(got[static_cast<std::size_t>(e)][k], want[k]) << "entry " << e << " k " << k;
+        std::vector<std::vector<double>> fs, gs;
+        double mag = 0;
+        for (std::size_t x = 0; x < 3; ++x) {
+          fs.push_back(w[3 * a + x]);
+          gs.push_back(w[3 * b + x]);
+          mag += largest_abs(fs.back()) * largest_abs(gs.back());
+        }
+        const auto exact = exact_product_sum(d, d, {1.0, 1.0, 1.0}, fs, gs);
+        for (std::size_t k = 0; k < want.size(); ++k)
+          EXPECT_LE(mpq_class(abs(mpq_class(mpq_class(got[static_cast<std::size_t>(e)][k]) - exact[k]))).get_d(),
+                    table.rounding(3) * mag);
+      }
+    }
 }
 
 TEST(MuBernsteinProduct, TripleProductMatchesTwoProducts) {
