@@ -62,19 +62,23 @@ void MuMetric::product(const BernsteinProduct& table,
                        std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms,
                        Poly& out) {
   out.c.assign(static_cast<std::size_t>(table.h_size()), 0.0);
-  double prop = 0, scale_fg = 0;
   int k = 0;
   std::array<BernsteinProduct::Term, 8> batch{};
   QV_ASSERT(terms.size() <= batch.size(), terms.size() << " terms");
-  for (const auto& [s, f, g] : terms) {
-    batch[static_cast<std::size_t>(k)] = {s, f->c.data(), g->c.data()};
-    prop += std::abs(s) * (f->mag * g->err + f->err * g->mag + f->err * g->err);
-    scale_fg += std::abs(s) * f->mag * g->mag;
-    ++k;
-  }
+  for (const auto& [s, f, g] : terms) batch[static_cast<std::size_t>(k++)] = {s, f->c.data(), g->c.data()};
   table.multiply_add_sum(std::span<const BernsteinProduct::Term>(batch.data(), static_cast<std::size_t>(k)),
                          out.c.data());
-  out.err = (prop + table.rounding(k) * scale_fg) * kSlack;
+  bound_product(table, terms, out);
+}
+
+void MuMetric::bound_product(const BernsteinProduct& table,
+                             std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms, Poly& out) {
+  double prop = 0, scale_fg = 0;
+  for (const auto& [s, f, g] : terms) {
+    prop += std::abs(s) * (f->mag * g->err + f->err * g->mag + f->err * g->err);
+    scale_fg += std::abs(s) * f->mag * g->mag;
+  }
+  out.err = (prop + table.rounding(static_cast<int>(terms.size())) * scale_fg) * kSlack;
   out.mag = max_abs(out.c);
 }
 
@@ -92,33 +96,27 @@ void MuMetric::metric_entries(const MuSpace& space, const double* w, double err)
   // each entry's error bound as product() gives it. mu of warped_pyramid_o2_N6_a0.15, one
   // thread, medians of 5: 18.3 -> 14.0 ms (the entries were a third of it; 6 walks before).
   {
-    // gram_sums' entry order, and where each goes in m_.
-    const bool d3 = dim == 3;
-    const std::array<int, 6> a_of = d3 ? std::array<int, 6>{0, 1, 2, 0, 0, 1} : std::array<int, 6>{0, 1, 0};
-    const std::array<int, 6> b_of = d3 ? std::array<int, 6>{0, 1, 2, 1, 2, 2} : std::array<int, 6>{0, 1, 1};
-    const std::array<int, 6> slot = d3 ? std::array<int, 6>{0, 1, 2, 3, 4, 5} : std::array<int, 6>{0, 1, 3};
-    const int entries = d3 ? 6 : 3;
+    const auto entry = [dim](int e) {
+      return dim == 3 ? BernsteinProduct::kGramEntries3[static_cast<std::size_t>(e)]
+                      : BernsteinProduct::kGramEntries2[static_cast<std::size_t>(e)];
+    };
+    // m_ holds m00, m11, m22, m01, m02, m12 (2D: m00, m11, -, m01).
+    const auto slot = [](const std::array<int, 2>& ab) { return ab[0] == ab[1] ? ab[0] : ab[0] + ab[1] + 2; };
+    const int entries = dim * (dim + 1) / 2;
     const double* columns[9];
     for (int j = 0; j < dim * 3; ++j) columns[j] = w_[j].c.data();
     double* out[6];
     for (int e = 0; e < entries; ++e) {
-      Poly& m = m_[slot[static_cast<std::size_t>(e)]];
+      Poly& m = m_[slot(entry(e))];
       m.c.assign(static_cast<std::size_t>(p11.h_size()), 0.0);
       out[e] = m.c.data();
     }
     if (p11.gram_sums(columns, dim, out)) {
       for (int e = 0; e < entries; ++e) {
-        const int a = a_of[static_cast<std::size_t>(e)], b = b_of[static_cast<std::size_t>(e)];
-        double prop = 0, scale_fg = 0;
-        for (int x = 0; x < 3; ++x) {
-          const Poly& f = w_[3 * a + x];
-          const Poly& g = w_[3 * b + x];
-          prop += f.mag * g.err + f.err * g.mag + f.err * g.err;
-          scale_fg += f.mag * g.mag;
-        }
-        Poly& m = m_[slot[static_cast<std::size_t>(e)]];
-        m.err = (prop + p11.rounding(3) * scale_fg) * kSlack;
-        m.mag = max_abs(m.c);
+        const auto [a, b] = entry(e);
+        bound_product(p11, {{1.0, &w_[3 * a], &w_[3 * b]}, {1.0, &w_[3 * a + 1], &w_[3 * b + 1]},
+                            {1.0, &w_[3 * a + 2], &w_[3 * b + 2]}},
+                      m_[slot(entry(e))]);
       }
       return;
     }

@@ -77,6 +77,9 @@ class MuMetric {
   };
   void product(const BernsteinProduct& table,
                std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms, Poly& out);
+  // out.err and out.mag of a sum of products of `table` already in out.c.
+  static void bound_product(const BernsteinProduct& table,
+                            std::initializer_list<std::tuple<double, const Poly*, const Poly*>> terms, Poly& out);
   void metric_entries(const MuSpace& space, const double* w, double err);
   bool certify_3d(double r);
   bool certify_direct(const BernsteinProduct& p66, double r);

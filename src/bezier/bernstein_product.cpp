@@ -491,9 +491,8 @@ void BernsteinProduct::gram_entries(const double* const* w, double* const* h) co
   // coefficient, its values laid out once as the 3 vectors (x = 0, 1, 2) of the a_e side
   // and the 3 of the b_e side, so that a pair costs three vector products and three sums.
   typedef double V8 __attribute__((vector_size(64)));
-  constexpr int kEntries = Columns * (Columns + 1) / 2;
-  constexpr std::array<int, 6> ea = Columns == 3 ? std::array<int, 6>{0, 1, 2, 0, 0, 1} : std::array<int, 6>{0, 1, 0};
-  constexpr std::array<int, 6> eb = Columns == 3 ? std::array<int, 6>{0, 1, 2, 1, 2, 2} : std::array<int, 6>{0, 1, 1};
+  constexpr std::size_t kEntries = Columns * (Columns + 1) / 2;
+  const auto entry = [](std::size_t e) { return Columns == 3 ? kGramEntries3[e] : kGramEntries2[e % 3]; };
   thread_local std::vector<V8> side_a, side_b;
   const auto n = static_cast<std::size_t>(f_size_);
   side_a.assign(3 * n, V8{});
@@ -501,8 +500,8 @@ void BernsteinProduct::gram_entries(const double* const* w, double* const* h) co
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t x = 0; x < 3; ++x)
       for (std::size_t e = 0; e < kEntries; ++e) {
-        side_a[3 * i + x][e] = w[3 * static_cast<std::size_t>(ea[e]) + x][i];
-        side_b[3 * i + x][e] = w[3 * static_cast<std::size_t>(eb[e]) + x][i];
+        side_a[3 * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[0]) + x][i];
+        side_b[3 * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[1]) + x][i];
       }
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
@@ -514,7 +513,7 @@ void BernsteinProduct::gram_entries(const double* const* w, double* const* h) co
       const V8 sum = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
       acc += pairs[p].w * sum;
     }
-    for (int e = 0; e < kEntries; ++e) h[e][k] += acc[e];
+    for (std::size_t e = 0; e < kEntries; ++e) h[e][k] += acc[e];
   }
 }
 

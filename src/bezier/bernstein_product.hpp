@@ -62,10 +62,13 @@ class BernsteinProduct {
   /// (a, b) of W^T W, h[e] += sum_x w[3 a + x] * w[3 b + x] (w[3 a + x]: coordinate x of
   /// column a, in this product's f space, which must equal its g space), with per entry
   /// the arithmetic of multiply_add_sum on its three terms (scales 1) by the general pairs,
-  /// so rounding(3) bounds each. Entries (0,0), (1,1), (2,2), (0,1), (0,2), (1,2); with 2
-  /// columns (0,0), (1,1), (0,1). Returns false, adding nothing, without an entry kernel
+  /// so rounding(3) bounds each, in the order of kGramEntries3 (kGramEntries2 for 2
+  /// columns). Returns false, adding nothing, without an entry kernel
   /// (large products): then one multiply_add_sum per entry.
   bool gram_sums(const double* const* w, int columns, double* const* h) const;
+  /// gram_sums' entries (a, b), in order: 3 columns, then 2.
+  static constexpr std::array<std::array<int, 2>, 6> kGramEntries3{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+  static constexpr std::array<std::array<int, 2>, 3> kGramEntries2{{{0, 0}, {1, 1}, {0, 1}}};
   /// Choose the per-factor weighted-entry loop (default for small products) or the scaled
   /// convolution (default for large ones); same product within rounding().
   void use_entry_kernel(bool on) noexcept { entries_kernel_ = on; }
