@@ -50,6 +50,14 @@ double up(double x) { return next_up(x); }
 // and hexahedra: hex_box 10% faster, but mixed_h0.6_o2 20% and warped_hexahedron_o2 25%
 // slower.
 constexpr int kQuotientSplits = 4;
+// Splits of the signed first stage on elements where J <= 0 was found (3D: tetrahedra,
+// prisms, hexahedra; scaled_jacobian_quotient.hpp). Invalid elements' sj, one thread (a
+// per-element harness; the machine was noisy, typical of 3 runs), full path alone -> 2, 4,
+// 8, 16 splits first: warped_hexahedron_o2 13.4 -> 5.3, 6.7, 6.5, 7.1 ms (all 156 settled
+// by 2); warped_prism_o2 29.9 -> 23.8, 19.2, 21.0, 18.4 ms (all 280 by 8);
+// warped_tetrahedron_o3 152 -> 151, 120, 104, 181 ms (540 of its 660 by 8, the rest
+// then take the full path); hex_box's 295 within noise.
+constexpr int kSignedSplits = 8;
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
 // rounding of at most u per operation; the final bounds are enlarged by 1% to cover the
@@ -539,6 +547,17 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
   return quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits);
 }
 
+QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
+                                           int max_splits) {
+  QV_ASSERT(scaled_jacobian_supported(type) && type.dim == 3 && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
+            "signed stage of " << type.name);
+  const ScaledJacobianSpace& space = scaled_jacobian_space(type);
+  thread_local Polys polys;
+  thread_local std::vector<double> values;
+  columns_and_jacobian(space, nodes, false, polys, values);
+  return signed_quotient_bounds(space, quotient_input(polys, 3), tol, max_splits);
+}
+
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
                                            const QualityOptions& options, bool planar, Validity v,
                                            const KnownMargin* known) {
@@ -575,6 +594,13 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   if (v == Validity::valid && !area) {
     quick = quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
                             std::min(kQuotientSplits, options.max_subdivisions));
+    if (quick.tolerance_met) return quick;
+  }
+  // Where J <= 0 was found (3D), the signed first stage likewise: J's coefficients with
+  // their signs over products of the columns along their mean directions.
+  if (v == Validity::invalid && dim == 3) {
+    quick = signed_quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
+                                   std::min(kSignedSplits, options.max_subdivisions));
     if (quick.tolerance_met) return quick;
   }
   if (area)

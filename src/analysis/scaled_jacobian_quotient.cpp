@@ -13,12 +13,14 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "bezier/bernstein_bisection.hpp"
+#include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr double kUnit = 0x1p-53;
 constexpr double kSqrt3 = 1.7320508075688772;  // a hair below sqrt(3): the 1 + 1e-12 of its use covers it
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
@@ -155,7 +157,8 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
 // Working arrays of Quotient, kept per thread from element to element (as members they
 // were allocated and freed for every element).
 struct QuotientScratch {
-  std::vector<double> sumsq, part, scratch, big, spread;
+  std::vector<double> sumsq, part, scratch, big, spread, product;
+  std::vector<std::vector<double>> along_of;  // signed bound: per distinct frame column
   std::vector<std::size_t> first, col0;
   std::vector<BisectionState> column_states;
 };
@@ -263,6 +266,152 @@ class Quotient {
     return lower;
   }
 
+  // True when L_k = prod_j (v_kj . d_kj) of every frame lies in J's space (tetrahedra,
+  // prisms, hexahedra: J's degrees are the sums of the columns'), as signed_bound needs.
+  bool signed_bound_applies() const {
+    if (dim_ != 3) return false;
+    const std::vector<FactorDegree>& j = *in_.j_degrees;
+    for (std::size_t f = 0; f < j.size(); ++f) {
+      int sum = 0;
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::vector<FactorDegree>& d = *in_.col_degrees[c];
+        if (d.size() != j.size() || d[f].dim != j[f].dim) return false;
+        sum += d[f].degree;
+      }
+      if (sum != j[f].degree) return false;
+    }
+    return true;
+  }
+
+  // On an element not proven valid (3D): a certified lower bound of sj on the leaf from J's
+  // coefficients, their signs included; `upper` is lowered to sj at the leaf's corners where
+  // J < 0 there. Per frame k, L_k = prod_j (v_kj . d_kj), d_kj a unit vector along the mean
+  // of v_kj's control points: |v . d| <= |v|, so where L_k's coefficients are positive (their
+  // errors included), 0 < L_k <= prod_j |v_kj| on the leaf, and where J < 0,
+  //   sj_k = s J / prod_j |v_kj| >= s J / L_k >= s min_i J_i / L_k,i
+  // (a ratio of Bernstein polynomials with positive denominator coefficients lies between
+  // its coefficients' ratios); where J >= 0, sj_k >= 0. So sj >= s min(0, min_k min_i J_i /
+  // L_k,i), and sj >= -s everywhere (Hadamard). Unlike J_lo over the norms' bounds, which
+  // come from different points, each ratio pairs J and L_k at the same coefficient, and L_k
+  // misses prod |v_kj| only by the cosines of the columns' spread on the leaf: the gap
+  // shrinks quadratically with the leaf, in the degree of J rather than 2n.
+  // Errors: a frame column's coordinates are within e (as in bound), so v . d (|d| <= 1)
+  // is within sqrt(3) e plus the dot product's rounding (gamma_3 sum |v_x d_x| <= 4u sqrt(3)
+  // max|v_x|); L_k's coefficients within the propagated errors of the three factors plus
+  // bernstein_triple_product's rounding bound.
+  double signed_bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
+    const std::size_t sj = in_.j.size();
+    const std::vector<int>& j_corners = layout_.j_tools->corners;
+    const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
+    // Per distinct frame column d: v_d . (its mean direction) at every control point, the
+    // largest magnitude of those and their error (the frames share their columns).
+    const std::size_t nd = layout_.distinct.size();
+    ws_.big.resize(nd);
+    ws_.spread.resize(nd);
+    if (ws_.along_of.size() < nd) ws_.along_of.resize(nd);
+    std::uint32_t unusable = 0;  // bit d: column d's mean vanishes
+    for (std::size_t dc = 0; dc < nd; ++dc) {
+      const FrameColumn& f = layout_.distinct[dc];
+      const auto c0 = static_cast<std::size_t>(f.column[0]);
+      const std::size_t n = layout_.size[c0];
+      double ev = 0, mag = 0;
+      for (int t = 0; t < f.terms; ++t) {
+        const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+        ev += err[c + 1] + gamma_ * in_.col_magnitude[c];
+      }
+      ws_.part.resize(3 * n);
+      std::array<double, 3> mean{0, 0, 0};
+      for (std::size_t x = 0; x < 3; ++x)
+        for (std::size_t i = 0; i < n; ++i) {
+          double v = 0;
+          for (int t = 0; t < f.terms; ++t) {
+            const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+            v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + i];
+          }
+          ws_.part[x * n + i] = v;
+          mean[x] += v;
+          mag = std::max(mag, std::abs(v));
+        }
+      const double len = sqrt_rn(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
+      if (!(len > 0) || !(len < kInf)) {
+        unusable |= 1u << dc;
+        continue;
+      }
+      std::array<double, 3> d{};
+      for (std::size_t x = 0; x < 3; ++x) d[x] = mean[x] / len * (1 - 1e-15);  // |d| <= 1
+      std::vector<double>& along = ws_.along_of[dc];
+      along.resize(n);
+      double big = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        along[i] = ws_.part[i] * d[0] + ws_.part[n + i] * d[1] + ws_.part[2 * n + i] * d[2];
+        big = std::max(big, std::abs(along[i]));
+      }
+      ws_.big[dc] = big;
+      ws_.spread[dc] = up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
+    }
+    double lower = kInf;
+    for (const auto& fr : layout_.frames) {
+      const bool usable = !(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]));
+      const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], ws_.big[fr[2]]};
+      const std::array<double, 3> e{ws_.spread[fr[0]], ws_.spread[fr[1]], ws_.spread[fr[2]]};
+      double frame_lower = -s_hi;  // Hadamard
+      if (usable) {
+        const std::vector<FactorDegree>& d0 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[0]].column[0])];
+        const std::vector<FactorDegree>& d1 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[1]].column[0])];
+        const std::vector<FactorDegree>& d2 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[2]].column[0])];
+        ws_.product.resize(sj);
+        const double rr = bernstein_triple_product(d0, ws_.along_of[fr[0]].data(), d1, ws_.along_of[fr[1]].data(), d2,
+                                                   ws_.along_of[fr[2]].data(), ws_.scratch, ws_.product.data());
+        const double mm = m[0] * m[1] * m[2];
+        const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
+        const double el = up((propagated + rr * mm) * (1 + 1e-10));
+        double least = 0;  // min(0, min_i J_i / L_i)
+        bool positive = true;
+        for (std::size_t i = 0; i < sj; ++i) {
+          const double den = down(ws_.product[i] - el);
+          if (!(den > 0)) {
+            positive = false;
+            break;
+          }
+          const double num = down(leaf[i] - err[0]);
+          if (num < 0) least = std::min(least, down(num / den));
+        }
+        if (positive) frame_lower = std::max(frame_lower, down(s_hi * least));
+      }
+      lower = std::min(lower, frame_lower);
+      // Upper bounds at the leaf's corners where J < 0 is certain: s J / prod |v_kj| with
+      // J at most J + e (negative) and the norms at most their computed values plus spread.
+      for (std::size_t mi = 0; mi < j_corners.size(); ++mi) {
+        const double j_hi = up(leaf[j_corners[mi]] + err[0]);
+        if (!(j_hi < 0)) continue;
+        double norm_product = 1;
+        for (std::size_t j = 0; j < 3; ++j) {
+          const FrameColumn& f = layout_.distinct[fr[j]];
+          const auto c0 = static_cast<std::size_t>(f.column[0]);
+          const std::size_t n = layout_.size[c0];
+          const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
+          double sum = 0, ev = 0;
+          for (std::size_t x = 0; x < 3; ++x) {
+            double v = 0;
+            for (int t = 0; t < f.terms; ++t) {
+              const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+              v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + at];
+            }
+            sum += v * v;
+          }
+          for (int t = 0; t < f.terms; ++t) {
+            const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+            ev += err[c + 1] + gamma_ * in_.col_magnitude[c];
+          }
+          const double spread = up(kSqrt3 * (1 + 1e-12) * up(ev * (1 + 1e-12)));
+          norm_product = up(norm_product * up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread));
+        }
+        upper = std::min(upper, up(s_lo * up(j_hi / norm_product)));
+      }
+    }
+    return lower;
+  }
+
   // Splits the leaf into the 2^dim children (child-major, stride() each) with their states
   // and errors (the same for all children).
   void split(const double* leaf, const std::array<double, 4>& err, const BisectionState& state,
@@ -292,6 +441,34 @@ class Quotient {
     }
   }
 
+  // One bisection of the leaf (BernsteinBisection::halve): the 2 children (stride() each,
+  // child-major), their states and errors.
+  void halve(const double* leaf, const std::array<double, 4>& err, const BisectionState& state,
+             std::vector<double>& children, std::vector<BisectionState>& states,
+             std::array<double, 4>& child_err) const {
+    const BernsteinBisection& jb = *layout_.j_tools->bisection;
+    children.resize(2 * layout_.stride);
+    states.resize(2);
+    const auto child_error = [](const BernsteinBisection& b, double e, const double* v, std::size_t n) {
+      return up((e + b.halving_rounding_relative() * largest_magnitude(v, n) + b.halving_rounding_absolute()) *
+                (1 + 1e-12));
+    };
+    const std::size_t sj = in_.j.size();
+    double* first = children.data();
+    double* second = children.data() + layout_.stride;
+    jb.halve(leaf, 1, state, first, second, states.data());
+    child_err[0] = child_error(jb, err[0], leaf, sj);
+    for (std::size_t c = 0; c < dim_; ++c) {
+      const BernsteinBisection& cb = *layout_.col_tools[c]->bisection;
+      const std::size_t at = layout_.offset[c + 1];
+      ws_.column_states.resize(2);
+      cb.halve(leaf + at, 3, state, first + at, second + at, ws_.column_states.data());
+      child_err[c + 1] = child_error(cb, err[c + 1], leaf + at, 3 * layout_.size[c]);
+    }
+  }
+
+  int levels() const { return layout_.j_tools->bisection->levels(); }
+
   BisectionState root_state() const { return layout_.j_tools->bisection->root_state(); }
 
  private:
@@ -303,6 +480,9 @@ class Quotient {
   QuotientScratch& ws_;
 };
 
+QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
+                     bool signs, QualityBounds out);
+
 }  // namespace
 
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
@@ -311,6 +491,25 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
   out.lower = -kInf;
   out.upper = space.s_hi();
   if (!(down(*std::min_element(in.j.begin(), in.j.end()) - in.j_error) > 0)) return out;
+  return refine(space, in, tol, max_splits, false, out);
+}
+
+QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
+                                     int max_splits) {
+  QualityBounds out;
+  out.lower = -kInf;
+  out.upper = 0;  // J <= 0 at a point, where sj <= 0
+  thread_local QuotientScratch scratch;
+  if (!Quotient(space, in, scratch).signed_bound_applies()) return out;
+  return refine(space, in, tol, max_splits, true, out);
+}
+
+namespace {
+
+// Best-first refinement of the leaves' bounds (bound, or signed_bound when `signs`), from
+// `out` holding the bounds known before.
+QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
+                     bool signs, QualityBounds out) {
   thread_local QuotientScratch scratch;
   const Quotient q(space, in, scratch);
   const std::size_t stride = q.stride();
@@ -331,7 +530,8 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
   const auto cmp = [](const Leaf& a, const Leaf& b) { return a.lower != b.lower ? a.lower > b.lower : a.id > b.id; };
   const auto push = [&](int slot) {
     const auto s = static_cast<std::size_t>(slot);
-    const double lo = q.bound(pool.data() + s * stride, pool_err[s], out.upper);
+    const double* leaf = pool.data() + s * stride;
+    const double lo = signs ? q.signed_bound(leaf, pool_err[s], out.upper) : q.bound(leaf, pool_err[s], out.upper);
     if (up(out.upper - lo) <= tol) {
       settled = std::min(settled, lo);  // stays good enough: upper only decreases
       free_slots.push_back(slot);
@@ -344,22 +544,29 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
   // The gap shrinks about linearly with the subdomain: a root far from the tolerance would
   // need more splits than the products of the full bounds cost (scaled_jacobian.cpp,
   // kQuotientSplits), so only a root within kReachable tolerances is refined.
-  if (!heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol) max_splits = 0;
+  if (!signs && !heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol) max_splits = 0;
   thread_local std::vector<double> parent;
   parent.resize(stride);
   std::array<double, 4> child_err{};
+  // The signed bound refines by single bisections (as the full bounds do), `levels` of
+  // them counting as one split.
+  const long levels = signs ? q.levels() : 1;
+  long steps = 0;
   while (!heap.empty()) {
     const Leaf top = heap.front();
-    if (up(out.upper - std::min(top.lower, settled)) <= tol || out.subdivisions >= max_splits) break;
+    if (up(out.upper - std::min(top.lower, settled)) <= tol || steps >= max_splits * levels) break;
     std::pop_heap(heap.begin(), heap.end(), cmp);
     heap.pop_back();
-    ++out.subdivisions;
+    ++steps;
     const auto ts = static_cast<std::size_t>(top.slot);
     std::copy_n(pool.data() + ts * stride, stride, parent.data());  // its slot is reused below
     const std::array<double, 4> parent_err = pool_err[ts];
     const BisectionState parent_state = states[ts];
     free_slots.push_back(top.slot);
-    q.split(parent.data(), parent_err, parent_state, children, child_states, child_err);
+    if (signs)
+      q.halve(parent.data(), parent_err, parent_state, children, child_states, child_err);
+    else
+      q.split(parent.data(), parent_err, parent_state, children, child_states, child_err);
     for (std::size_t c = 0; c < child_states.size(); ++c) {
       int slot;
       if (!free_slots.empty()) {
@@ -378,11 +585,14 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
       push(slot);
     }
   }
+  out.subdivisions = static_cast<int>((steps + levels - 1) / levels);
   double lower = settled;
   for (const Leaf& l : heap) lower = std::min(lower, l.lower);
   out.lower = lower;
   out.tolerance_met = up(out.upper - out.lower) <= tol;
   return out;
 }
+
+}  // namespace
 
 }  // namespace quadval

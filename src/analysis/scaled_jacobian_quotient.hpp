@@ -20,6 +20,11 @@
 // gap closes slowly: warped_prism_o2_N6_a0.25 needed 55 splits per invalid element where
 // the full bounds' ratios of N and D_k need 3, and within the 4 splits used here it settled
 // none of the invalid elements of the warped meshes (sj time unchanged or worse).
+// What works there instead (signed_quotient_bounds): the ratios J_i / L_k,i coefficient by
+// coefficient in J's space, L_k = prod_j (v_kj . d_kj) with d_kj the mean direction of the
+// column's control points, so that J and the denominator are paired at the same point; it
+// settles all invalid elements of warped_hexahedron_o2 and warped_prism_o2 and 540 of the
+// 660 of warped_tetrahedron_o3 within 8 splits (single bisections, as the full bounds).
 //
 // Errors: every coefficient carries an a priori bound (its input's, plus the bisection's
 // rounding_relative() * max|parent| + rounding_absolute() per split); a frame column is a
@@ -56,5 +61,12 @@ struct QuotientInput {
 /// refined); subdivisions counts the splits; tolerance_met says whether the gap closed.
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
                               int max_splits);
+
+/// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D, with
+/// the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's signs: refined by
+/// at most max_splits best-first splits. Nothing (lower = -inf, upper = 0) for the types
+/// whose J does not lie in the space of the product of the three columns (pyramids).
+QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
+                                     int max_splits);
 
 }  // namespace quadval

@@ -86,6 +86,13 @@ const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type);
 QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<const double> nodes, bool planar,
                                              double tol, int max_splits);
 
+/// The signed first stage on its own (tests): bounds of sj(E) of a 3D element where J <= 0
+/// was found at a point (the caller's claim: upper starts at 0), from J's coefficients with
+/// their signs and the columns (scaled_jacobian_quotient.hpp), refined by at most max_splits
+/// splits; lower = -inf for pyramids.
+QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
+                                           int max_splits);
+
 /// Tests only: switch off (on by default), in the calling thread, the closed-form bounds of
 /// valid straight-sided simplices (planar triangles, tetrahedra: columns within the
 /// straight_sided.hpp margins of their edges) and of valid bilinear planar quadrangles
