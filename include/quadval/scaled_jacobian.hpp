@@ -70,8 +70,8 @@
 /// their own degrees (convex hull), exact on straight-sided simplices and parallelepipeds;
 /// it settles the straight and barely curved elements that make up most of a curved mesh,
 /// and its bounds tighten the ones below when it does not (src/analysis/
-/// scaled_jacobian_quotient.hpp). On a 3D element where J <= 0 was found (tetrahedra,
-/// prisms, hexahedra), a signed first stage: sj >= s min(0, min_k min_i J_i / L_k,i) with
+/// scaled_jacobian_quotient.hpp). On a prism or hexahedron where J <= 0 was found, a
+/// signed first stage: sj >= s min(0, min_k min_i J_i / L_k,i) with
 /// L_k = prod_j (v_kj . d_kj) <= prod_j |v_kj| (d_kj unit vectors along the columns' mean
 /// directions; L_k's coefficients proven positive), in J's degree, refined a few times.
 /// Before it, on valid elements, closed forms or fixed-size

@@ -50,13 +50,14 @@ double up(double x) { return next_up(x); }
 // and hexahedra: hex_box 10% faster, but mixed_h0.6_o2 20% and warped_hexahedron_o2 25%
 // slower.
 constexpr int kQuotientSplits = 4;
-// Splits of the signed first stage on elements where J <= 0 was found (3D: tetrahedra,
-// prisms, hexahedra; scaled_jacobian_quotient.hpp). Invalid elements' sj, one thread (a
-// per-element harness; the machine was noisy, typical of 3 runs), full path alone -> 2, 4,
-// 8, 16 splits first: warped_hexahedron_o2 13.4 -> 5.3, 6.7, 6.5, 7.1 ms (all 156 settled
-// by 2); warped_prism_o2 29.9 -> 23.8, 19.2, 21.0, 18.4 ms (all 280 by 8);
-// warped_tetrahedron_o3 152 -> 151, 120, 104, 181 ms (540 of its 660 by 8, the rest
-// then take the full path); hex_box's 295 within noise.
+// Splits of the signed first stage on prisms and hexahedra where J <= 0 was found
+// (scaled_jacobian_quotient.hpp). Invalid elements' sj, one thread, a per-element harness,
+// full path alone -> 2, 4, 8, 16 splits first (one run each, noisy): warped_hexahedron_o2
+// 13.4 -> 5.3, 6.7, 6.5, 7.1 ms (all 156 settled by 2); warped_prism_o2 29.9 -> 23.8, 19.2,
+// 21.0, 18.4 ms (all 280 by 8; best of 7: 17.8 -> 11.5 ms at 8); hex_box's 295 within
+// noise. Not for tetrahedra: it settles 540 of the 660 of warped_tetrahedron_o3 in 8
+// splits, but with four frames per leaf no faster than the full bounds (best of 7: 92 ->
+// 98 ms; tets_h0.8_o2's 11: 0.40 -> 0.49 ms).
 constexpr int kSignedSplits = 8;
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
@@ -596,9 +597,9 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
                             std::min(kQuotientSplits, options.max_subdivisions));
     if (quick.tolerance_met) return quick;
   }
-  // Where J <= 0 was found (3D), the signed first stage likewise: J's coefficients with
-  // their signs over products of the columns along their mean directions.
-  if (v == Validity::invalid && dim == 3) {
+  // Where J <= 0 was found (prisms, hexahedra), the signed first stage likewise: J's
+  // coefficients with their signs over products of the columns along their mean directions.
+  if (v == Validity::invalid && (type.family == ElementFamily::prism || type.family == ElementFamily::hexahedron)) {
     quick = signed_quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
                                    std::min(kSignedSplits, options.max_subdivisions));
     if (quick.tolerance_met) return quick;

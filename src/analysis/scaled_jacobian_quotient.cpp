@@ -157,7 +157,7 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
 // Working arrays of Quotient, kept per thread from element to element (as members they
 // were allocated and freed for every element).
 struct QuotientScratch {
-  std::vector<double> sumsq, part, scratch, big, spread, product;
+  std::vector<double> sumsq, part, scratch, big, spread, product, frame_err, along_err;
   std::vector<std::vector<double>> along_of;  // signed bound: per distinct frame column
   std::vector<std::size_t> first, col0;
   std::vector<BisectionState> column_states;
@@ -187,6 +187,30 @@ class Quotient {
     }
   }
 
+  // Coordinate x of frame column f at control point i of the leaf (its columns of n
+  // coefficients per coordinate).
+  double frame_coordinate(const double* leaf, const FrameColumn& f, std::size_t n, std::size_t x,
+                          std::size_t i) const {
+    double v = 0;
+    for (int t = 0; t < f.terms; ++t) {
+      const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+      v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + i];
+    }
+    return v;
+  }
+  // Bound on |computed - exact| of each coordinate of frame column f: its columns' errors
+  // and the rounding of the sum.
+  double frame_error(const FrameColumn& f, const std::array<double, 4>& err) const {
+    double e = 0;
+    for (int t = 0; t < f.terms; ++t) {
+      const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+      e += err[c + 1] + gamma_ * in_.col_magnitude[c];
+    }
+    return e;
+  }
+  // Bound on how far a control point's norm moves with its coordinates' errors e.
+  static double norm_spread(double e) { return up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12))); }
+
   // A certified lower bound of sj on the leaf; `upper` is lowered to sj at one of its
   // corners (the one the squares estimate smallest, per frame), certified there.
   double bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
@@ -204,12 +228,7 @@ class Quotient {
     ws_.spread.resize(nd);
     for (std::size_t d = 0; d < nd; ++d) {
       const FrameColumn& f = layout_.distinct[d];
-      double e = 0;
-      for (int t = 0; t < f.terms; ++t) {
-        const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-        e += err[c + 1] + gamma_ * in_.col_magnitude[c];
-      }
-      ws_.spread[d] = up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
+      ws_.spread[d] = norm_spread(frame_error(f, err));
       ws_.col0[d] = static_cast<std::size_t>(f.column[0]);
       const std::size_t n = layout_.size[ws_.col0[d]];
       ws_.first[d] = ws_.sumsq.size();
@@ -217,11 +236,7 @@ class Quotient {
       for (std::size_t i = 0; i < n; ++i) {
         double sum = 0;
         for (std::size_t x = 0; x < 3; ++x) {
-          double v = 0;
-          for (int t = 0; t < f.terms; ++t) {
-            const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-            v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + i];
-          }
+          const double v = frame_coordinate(leaf, f, n, x, i);
           sum += v * v;
         }
         ws_.sumsq.push_back(sum);
@@ -307,27 +322,22 @@ class Quotient {
     // largest magnitude of those and their error (the frames share their columns).
     const std::size_t nd = layout_.distinct.size();
     ws_.big.resize(nd);
-    ws_.spread.resize(nd);
+    ws_.along_err.resize(nd);
+    ws_.frame_err.resize(nd);
     if (ws_.along_of.size() < nd) ws_.along_of.resize(nd);
     std::uint32_t unusable = 0;  // bit d: column d's mean vanishes
     for (std::size_t dc = 0; dc < nd; ++dc) {
       const FrameColumn& f = layout_.distinct[dc];
       const auto c0 = static_cast<std::size_t>(f.column[0]);
       const std::size_t n = layout_.size[c0];
-      double ev = 0, mag = 0;
-      for (int t = 0; t < f.terms; ++t) {
-        const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-        ev += err[c + 1] + gamma_ * in_.col_magnitude[c];
-      }
+      const double ev = frame_error(f, err);
+      ws_.frame_err[dc] = ev;  // for the corners' norms below
+      double mag = 0;
       ws_.part.resize(3 * n);
       std::array<double, 3> mean{0, 0, 0};
       for (std::size_t x = 0; x < 3; ++x)
         for (std::size_t i = 0; i < n; ++i) {
-          double v = 0;
-          for (int t = 0; t < f.terms; ++t) {
-            const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-            v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + i];
-          }
+          const double v = frame_coordinate(leaf, f, n, x, i);
           ws_.part[x * n + i] = v;
           mean[x] += v;
           mag = std::max(mag, std::abs(v));
@@ -347,13 +357,13 @@ class Quotient {
         big = std::max(big, std::abs(along[i]));
       }
       ws_.big[dc] = big;
-      ws_.spread[dc] = up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
+      ws_.along_err[dc] = up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
     }
     double lower = kInf;
     for (const auto& fr : layout_.frames) {
       const bool usable = !(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]));
       const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], ws_.big[fr[2]]};
-      const std::array<double, 3> e{ws_.spread[fr[0]], ws_.spread[fr[1]], ws_.spread[fr[2]]};
+      const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], ws_.along_err[fr[2]]};
       double frame_lower = -s_hi;  // Hadamard
       if (usable) {
         const std::vector<FactorDegree>& d0 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[0]].column[0])];
@@ -390,20 +400,12 @@ class Quotient {
           const auto c0 = static_cast<std::size_t>(f.column[0]);
           const std::size_t n = layout_.size[c0];
           const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
-          double sum = 0, ev = 0;
+          double sum = 0;
           for (std::size_t x = 0; x < 3; ++x) {
-            double v = 0;
-            for (int t = 0; t < f.terms; ++t) {
-              const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-              v += f.weight[static_cast<std::size_t>(t)] * leaf[layout_.offset[c + 1] + x * n + at];
-            }
+            const double v = frame_coordinate(leaf, f, n, x, at);
             sum += v * v;
           }
-          for (int t = 0; t < f.terms; ++t) {
-            const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-            ev += err[c + 1] + gamma_ * in_.col_magnitude[c];
-          }
-          const double spread = up(kSqrt3 * (1 + 1e-12) * up(ev * (1 + 1e-12)));
+          const double spread = norm_spread(ws_.frame_err[fr[j]]);
           norm_product = up(norm_product * up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread));
         }
         upper = std::min(upper, up(s_lo * up(j_hi / norm_product)));
