@@ -100,6 +100,15 @@ struct QuotientLayout {
   std::size_t stride = 0;
   std::vector<FrameColumn> distinct;              // frame columns, first weight positive
   std::vector<std::array<std::size_t, 3>> frames;  // per frame: its columns in `distinct`
+  // Per frame, for the signed bound (3D, when the three columns' product lies in J's
+  // space): the tables of (v_1 v_2) and of (v_1 v_2) v_3, and the relative rounding bound of
+  // that triple product (as bernstein_triple_product); empty otherwise.
+  struct TripleProduct {
+    const BernsteinProduct* first = nullptr;
+    const BernsteinProduct* second = nullptr;
+    double rounding = 0;
+  };
+  std::vector<TripleProduct> triple;
 };
 
 QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput& in) {
@@ -141,6 +150,33 @@ QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput
       if (it == q.distinct.end()) q.distinct.push_back(f);
     }
     q.frames.push_back(slots);
+  }
+  // The triple products' tables, where the columns' degrees add up to J's.
+  if (dim == 3) {
+    const std::vector<FactorDegree>& j = *in.j_degrees;
+    std::vector<FactorDegree> sum(j.size());
+    bool same = true;
+    for (std::size_t f = 0; f < j.size() && same; ++f) {
+      sum[f] = {j[f].dim, 0};
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::vector<FactorDegree>& d = *in.col_degrees[c];
+        same = same && d.size() == j.size() && d[f].dim == j[f].dim;
+        if (same) sum[f].degree += d[f].degree;
+      }
+      same = same && sum[f].degree == j[f].degree;
+    }
+    if (same)
+      for (const auto& fr : q.frames) {
+        const auto& d0 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[0]].column[0])];
+        const auto& d1 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[1]].column[0])];
+        const auto& d2 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[2]].column[0])];
+        QuotientLayout::TripleProduct t;
+        t.first = &bernstein_product(d0, d1);
+        t.second = &bernstein_product(product_degrees(d0, d1), d2);
+        const double r1 = t.first->rounding(1), r2 = t.second->rounding(1);
+        t.rounding = (r1 + r2 * (1 + r1)) * 1.01;
+        q.triple.push_back(t);
+      }
   }
   return q;
 }
@@ -283,20 +319,7 @@ class Quotient {
 
   // True when L_k = prod_j (v_kj . d_kj) of every frame lies in J's space (tetrahedra,
   // prisms, hexahedra: J's degrees are the sums of the columns'), as signed_bound needs.
-  bool signed_bound_applies() const {
-    if (dim_ != 3) return false;
-    const std::vector<FactorDegree>& j = *in_.j_degrees;
-    for (std::size_t f = 0; f < j.size(); ++f) {
-      int sum = 0;
-      for (std::size_t c = 0; c < 3; ++c) {
-        const std::vector<FactorDegree>& d = *in_.col_degrees[c];
-        if (d.size() != j.size() || d[f].dim != j[f].dim) return false;
-        sum += d[f].degree;
-      }
-      if (sum != j[f].degree) return false;
-    }
-    return true;
-  }
+  bool signed_bound_applies() const { return !layout_.triple.empty(); }
 
   // On an element not proven valid (3D): a certified lower bound of sj on the leaf from J's
   // coefficients, their signs included; `upper` is lowered to sj at the leaf's corners where
@@ -360,18 +383,19 @@ class Quotient {
       ws_.along_err[dc] = up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
     }
     double lower = kInf;
-    for (const auto& fr : layout_.frames) {
+    for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
+      const auto& fr = layout_.frames[k];
       const bool usable = !(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]));
       const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], ws_.big[fr[2]]};
       const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], ws_.along_err[fr[2]]};
       double frame_lower = -s_hi;  // Hadamard
       if (usable) {
-        const std::vector<FactorDegree>& d0 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[0]].column[0])];
-        const std::vector<FactorDegree>& d1 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[1]].column[0])];
-        const std::vector<FactorDegree>& d2 = *in_.col_degrees[static_cast<std::size_t>(layout_.distinct[fr[2]].column[0])];
+        const QuotientLayout::TripleProduct& tp = layout_.triple[k];
         ws_.product.resize(sj);
-        const double rr = bernstein_triple_product(d0, ws_.along_of[fr[0]].data(), d1, ws_.along_of[fr[1]].data(), d2,
-                                                   ws_.along_of[fr[2]].data(), ws_.scratch, ws_.product.data());
+        ws_.scratch.resize(static_cast<std::size_t>(tp.first->h_size()));
+        tp.first->multiply(ws_.along_of[fr[0]].data(), ws_.along_of[fr[1]].data(), ws_.scratch.data());
+        tp.second->multiply(ws_.scratch.data(), ws_.along_of[fr[2]].data(), ws_.product.data());
+        const double rr = tp.rounding;
         const double mm = m[0] * m[1] * m[2];
         const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
         const double el = up((propagated + rr * mm) * (1 + 1e-10));
