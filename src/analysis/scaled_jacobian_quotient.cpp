@@ -317,10 +317,6 @@ class Quotient {
     return lower;
   }
 
-  // True when L_k = prod_j (v_kj . d_kj) of every frame lies in J's space (tetrahedra,
-  // prisms, hexahedra: J's degrees are the sums of the columns'), as signed_bound needs.
-  bool signed_bound_applies() const { return !layout_.triple.empty(); }
-
   // On an element not proven valid (3D): a certified lower bound of sj on the leaf from J's
   // coefficients, their signs included; `upper` is lowered to sj at the leaf's corners where
   // J < 0 there. Per frame k, L_k = prod_j (v_kj . d_kj), d_kj a unit vector along the mean
@@ -525,8 +521,7 @@ QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const Quo
   QualityBounds out;
   out.lower = -kInf;
   out.upper = 0;  // J <= 0 at a point, where sj <= 0
-  thread_local QuotientScratch scratch;
-  if (!Quotient(space, in, scratch).signed_bound_applies()) return out;
+  if (layout_of(space, in).triple.empty()) return out;  // L_k outside J's space (pyramids)
   return refine(space, in, tol, max_splits, true, out);
 }
 
