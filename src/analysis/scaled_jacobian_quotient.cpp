@@ -102,7 +102,7 @@ struct QuotientLayout {
   std::vector<std::array<std::size_t, 3>> frames;  // per frame: its columns in `distinct`
   // Per frame, for the signed bound (3D, when the three columns' product lies in J's
   // space): the tables of (v_1 v_2) and of (v_1 v_2) v_3, and the relative rounding bound of
-  // that triple product (as bernstein_triple_product); empty otherwise.
+  // that triple product (triple_product_rounding); empty otherwise.
   struct TripleProduct {
     const BernsteinProduct* first = nullptr;
     const BernsteinProduct* second = nullptr;
@@ -173,8 +173,7 @@ QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput
         QuotientLayout::TripleProduct t;
         t.first = &bernstein_product(d0, d1);
         t.second = &bernstein_product(product_degrees(d0, d1), d2);
-        const double r1 = t.first->rounding(1), r2 = t.second->rounding(1);
-        t.rounding = (r1 + r2 * (1 + r1)) * 1.01;
+        t.rounding = triple_product_rounding(*t.first, *t.second);
         q.triple.push_back(t);
       }
   }
@@ -193,7 +192,7 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
 // Working arrays of Quotient, kept per thread from element to element (as members they
 // were allocated and freed for every element).
 struct QuotientScratch {
-  std::vector<double> sumsq, part, scratch, big, spread, product, frame_err, along_err;
+  std::vector<double> sumsq, part, scratch, big, spread, product, along_err, corner_norm;
   std::vector<std::vector<double>> along_of;  // signed bound: per distinct frame column
   std::vector<std::size_t> first, col0;
   std::vector<BisectionState> column_states;
@@ -332,17 +331,19 @@ class Quotient {
   // Errors: a frame column's coordinates are within e (as in bound), so v . d (|d| <= 1)
   // is within sqrt(3) e plus the dot product's rounding (gamma_3 sum |v_x d_x| <= 4u sqrt(3)
   // max|v_x|); L_k's coefficients within the propagated errors of the three factors plus
-  // bernstein_triple_product's rounding bound.
+  // triple_product_rounding's bound.
   double signed_bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
     const std::size_t sj = in_.j.size();
     const std::vector<int>& j_corners = layout_.j_tools->corners;
     const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
     // Per distinct frame column d: v_d . (its mean direction) at every control point, the
-    // largest magnitude of those and their error (the frames share their columns).
+    // largest magnitude of those and their error, and an upper bound of |v_d| at each of
+    // the leaf's corners (the frames share their columns).
     const std::size_t nd = layout_.distinct.size();
+    const std::size_t corners = j_corners.size();
     ws_.big.resize(nd);
     ws_.along_err.resize(nd);
-    ws_.frame_err.resize(nd);
+    ws_.corner_norm.resize(nd * corners);
     if (ws_.along_of.size() < nd) ws_.along_of.resize(nd);
     std::uint32_t unusable = 0;  // bit d: column d's mean vanishes
     for (std::size_t dc = 0; dc < nd; ++dc) {
@@ -350,7 +351,6 @@ class Quotient {
       const auto c0 = static_cast<std::size_t>(f.column[0]);
       const std::size_t n = layout_.size[c0];
       const double ev = frame_error(f, err);
-      ws_.frame_err[dc] = ev;  // for the corners' norms below
       double mag = 0;
       ws_.part.resize(3 * n);
       std::array<double, 3> mean{0, 0, 0};
@@ -361,6 +361,13 @@ class Quotient {
           mean[x] += v;
           mag = std::max(mag, std::abs(v));
         }
+      const double spread = norm_spread(ev);
+      for (std::size_t mi = 0; mi < corners; ++mi) {
+        const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
+        double sum = 0;
+        for (std::size_t x = 0; x < 3; ++x) sum += ws_.part[x * n + at] * ws_.part[x * n + at];
+        ws_.corner_norm[dc * corners + mi] = up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread);
+      }
       const double len = sqrt_rn(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
       if (!(len > 0) || !(len < kInf)) {
         unusable |= 1u << dc;
@@ -411,23 +418,11 @@ class Quotient {
       lower = std::min(lower, frame_lower);
       // Upper bounds at the leaf's corners where J < 0 is certain: s J / prod |v_kj| with
       // J at most J + e (negative) and the norms at most their computed values plus spread.
-      for (std::size_t mi = 0; mi < j_corners.size(); ++mi) {
+      for (std::size_t mi = 0; mi < corners; ++mi) {
         const double j_hi = up(leaf[j_corners[mi]] + err[0]);
         if (!(j_hi < 0)) continue;
         double norm_product = 1;
-        for (std::size_t j = 0; j < 3; ++j) {
-          const FrameColumn& f = layout_.distinct[fr[j]];
-          const auto c0 = static_cast<std::size_t>(f.column[0]);
-          const std::size_t n = layout_.size[c0];
-          const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
-          double sum = 0;
-          for (std::size_t x = 0; x < 3; ++x) {
-            const double v = frame_coordinate(leaf, f, n, x, at);
-            sum += v * v;
-          }
-          const double spread = norm_spread(ws_.frame_err[fr[j]]);
-          norm_product = up(norm_product * up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread));
-        }
+        for (std::size_t j = 0; j < 3; ++j) norm_product = up(norm_product * ws_.corner_norm[fr[j] * corners + mi]);
         upper = std::min(upper, up(s_lo * up(j_hi / norm_product)));
       }
     }

@@ -624,6 +624,10 @@ double bernstein_triple_product(std::span<const FactorDegree> f_deg, const doubl
   scratch.resize(static_cast<std::size_t>(fg.h_size()));
   fg.multiply(f, g, scratch.data());
   fgk.multiply(scratch.data(), k, out);
+  return triple_product_rounding(fg, fgk);
+}
+
+double triple_product_rounding(const BernsteinProduct& fg, const BernsteinProduct& fgk) {
   // |fg~ - fg| <= r1 F G, so |fg~| <= (1 + r1) F G; then r2 on the second product.
   const double r1 = fg.rounding(1), r2 = fgk.rounding(1);
   return (r1 + r2 * (1 + r1)) * 1.01;

@@ -153,6 +153,10 @@ class BernsteinProduct {
 const BernsteinProduct& bernstein_product(std::span<const FactorDegree> f,
                                           std::span<const FactorDegree> g);
 
+/// The relative rounding bound of a product (f g) k computed with the tables fg = (f, g)
+/// and fgk = (f g, k): |out - exact| <= returned * max|f| max|g| max|k|.
+double triple_product_rounding(const BernsteinProduct& fg, const BernsteinProduct& fgk);
+
 /// out = f * g * k (three factors of §5.1, as (f g) k), scratch sized for f * g.
 /// @return the relative rounding bound: |out - exact| <= returned * max|f| max|g| max|k|
 double bernstein_triple_product(std::span<const FactorDegree> f_deg, const double* f,
