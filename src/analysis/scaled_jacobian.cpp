@@ -39,8 +39,8 @@ constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
-// Splits of J and the columns before the products (the quotient stage, which refines only
-// a root within twice the tolerance). Measured on the shared curved meshes at --tol 1e-2:
+// Splits of J and the columns before the products, 2D (the quotient stage, which refines
+// only a root within twice the tolerance). Measured on the shared curved meshes at --tol 1e-2:
 // 16 splits of any root made linear hexahedra 10x and quadratic quadrangles 5x slower (the
 // gap of a distorted element closes only linearly); 4 near the tolerance gain a little
 // (warped_pyramid_o2: 163 elements settled by one split). A root within 4 tolerances
@@ -50,14 +50,21 @@ double up(double x) { return next_up(x); }
 // and hexahedra: hex_box 10% faster, but mixed_h0.6_o2 20% and warped_hexahedron_o2 25%
 // slower.
 constexpr int kQuotientSplits = 4;
-// Splits of the signed first stage on prisms and hexahedra where J <= 0 was found
+// Splits of the paired first stage of valid 3D elements (single bisections, `levels` of
+// them one split; scaled_jacobian_quotient.cpp, paired_bound). sj of the valid elements,
+// one thread, a per-element harness, best of 5, unpaired stage -> 4, 8, 16 splits:
+// warped_pyramid_o2 71 -> 35 ms at any (its 1,290 all settled by 8, none by the products
+// of (6r + 1)^3 coefficients), mixed_h0.6_o2 9.9 -> 7.4 ms, warped_tetrahedron_o3 17.2 ->
+// 15.5 ms, warped_prism_o2 2.4 -> 2.1 ms, the others within noise.
+constexpr int kPairedSplits = 8;
+// Splits of the signed first stage of 3D elements where J <= 0 was found
 // (scaled_jacobian_quotient.hpp). Invalid elements' sj, one thread, a per-element harness,
 // full path alone -> 2, 4, 8, 16 splits first (one run each, noisy): warped_hexahedron_o2
 // 13.4 -> 5.3, 6.7, 6.5, 7.1 ms (all 156 settled by 2); warped_prism_o2 29.9 -> 23.8, 19.2,
 // 21.0, 18.4 ms (all 280 by 8; best of 7: 17.8 -> 11.5 ms at 8); hex_box's 295 within
-// noise. Not for tetrahedra: it settles 540 of the 660 of warped_tetrahedron_o3 in 8
-// splits, but with four frames per leaf no faster than the full bounds (best of 7: 92 ->
-// 98 ms; tets_h0.8_o2's 11: 0.40 -> 0.49 ms).
+// noise. Tetrahedra (four frames per leaf) gained once its ratios were scanned without a
+// division each (ratio_scan.hpp): warped_tetrahedron_o3's 660, best of 5, three runs
+// each, 94-96 -> 82-87 ms.
 constexpr int kSignedSplits = 8;
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
@@ -545,7 +552,7 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
   thread_local Polys polys;
   thread_local std::vector<double> values;
   columns_and_jacobian(space, nodes, planar, polys, values);
-  return quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits);
+  return quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits, max_splits);
 }
 
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
@@ -594,12 +601,13 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   QualityBounds quick{-kInf, space.s_hi(), 0, false};
   if (v == Validity::valid && !area) {
     quick = quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
-                            std::min(kQuotientSplits, options.max_subdivisions));
+                            std::min(kQuotientSplits, options.max_subdivisions),
+                            std::min(kPairedSplits, options.max_subdivisions));
     if (quick.tolerance_met) return quick;
   }
-  // Where J <= 0 was found (prisms, hexahedra), the signed first stage likewise: J's
-  // coefficients with their signs over products of the columns along their mean directions.
-  if (v == Validity::invalid && (type.family == ElementFamily::prism || type.family == ElementFamily::hexahedron)) {
+  // Where J <= 0 was found (3D), the signed first stage likewise: J's coefficients with
+  // their signs over products of the columns along their mean directions.
+  if (v == Validity::invalid && dim == 3) {
     quick = signed_quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
                                    std::min(kSignedSplits, options.max_subdivisions));
     if (quick.tolerance_met) return quick;

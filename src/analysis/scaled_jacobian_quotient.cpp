@@ -11,6 +11,7 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/ratio_scan.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
@@ -25,6 +26,11 @@ constexpr double kSqrt3 = 1.7320508075688772;  // a hair below sqrt(3): the 1 + 
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
 constexpr double kReachable = 2;
+// The paired bound's gap shrinks quadratically: a root within 4 tolerances is refined.
+// sj of the valid elements, one thread, best of 5, within 2, 4, 10, 30 tolerances or any:
+// warped_tetrahedron_o3 15.5 (at 4) against 17-22 ms (10 and above), mixed_h0.6_o2 7.4
+// against 7.2-8.6, warped_pyramid_o2 about 35 ms at any.
+constexpr double kPairedReachable = 4;
 
 std::uint64_t key_of(const std::vector<FactorDegree>& deg) {
   std::uint64_t key = deg.size();
@@ -192,7 +198,7 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
 // Working arrays of Quotient, kept per thread from element to element (as members they
 // were allocated and freed for every element).
 struct QuotientScratch {
-  std::vector<double> sumsq, part, scratch, big, spread, product, along_err, corner_norm;
+  std::vector<double> sumsq, part, scratch, big, spread, product, along_err, corner_norm, corner_norm_lo, norm_big;
   std::vector<std::vector<double>> along_of;  // signed bound: per distinct frame column
   std::vector<std::size_t> first, col0;
   std::vector<BisectionState> column_states;
@@ -328,24 +334,116 @@ class Quotient {
   // come from different points, each ratio pairs J and L_k at the same coefficient, and L_k
   // misses prod |v_kj| only by the cosines of the columns' spread on the leaf: the gap
   // shrinks quadratically with the leaf, in the degree of J rather than 2n.
-  // Errors: a frame column's coordinates are within e (as in bound), so v . d (|d| <= 1)
-  // is within sqrt(3) e plus the dot product's rounding (gamma_3 sum |v_x d_x| <= 4u sqrt(3)
-  // max|v_x|); L_k's coefficients within the propagated errors of the three factors plus
-  // triple_product_rounding's bound.
   double signed_bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
     const std::size_t sj = in_.j.size();
     const std::vector<int>& j_corners = layout_.j_tools->corners;
     const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
-    // Per distinct frame column d: v_d . (its mean direction) at every control point, the
-    // largest magnitude of those and their error, and an upper bound of |v_d| at each of
-    // the leaf's corners (the frames share their columns).
+    const std::size_t corners = j_corners.size();
+    const std::uint32_t unusable = directional_columns(leaf, err, false);
+    double lower = kInf;
+    for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
+      const auto& fr = layout_.frames[k];
+      double frame_lower = -s_hi;  // Hadamard
+      if (!(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]))) {
+        // min(0, min_i (J_i - e) / (L_i - e_L)) without directed roundings (ratio_scan.hpp):
+        // each quotient within three roundings of the exact one; rounding keeps signs.
+        const double el = frame_product(k);
+        const RatioScan scan = scan_ratios<true>(leaf, -err[0], ws_.product.data(), -el, -el, sj);
+        if (scan.least_den > 0) {
+          const double least = std::min(scan.extreme, 0.0);
+          const double bound = least < 0 ? down(down(least * (1 + 4 * kUnit)) - std::numeric_limits<double>::denorm_min()) : 0.0;
+          frame_lower = std::max(frame_lower, down(s_hi * bound));
+        }
+      }
+      lower = std::min(lower, frame_lower);
+      // Upper bounds at the leaf's corners where J < 0 is certain: s J / prod |v_kj| with
+      // J at most J + e (negative) and the norms at most their computed values plus spread.
+      for (std::size_t mi = 0; mi < corners; ++mi) {
+        const double j_hi = up(leaf[j_corners[mi]] + err[0]);
+        if (!(j_hi < 0)) continue;
+        double norm_product = 1;
+        for (std::size_t j = 0; j < 3; ++j) norm_product = up(norm_product * ws_.corner_norm[fr[j] * corners + mi]);
+        upper = std::min(upper, up(s_lo * up(j_hi / norm_product)));
+      }
+    }
+    return lower;
+  }
+
+  // On an element where J > 0 is proven (3D): the same pairing with an upper bound of the
+  // norms. With a = v . d (d as above) and r = |v|^2 - a^2 = v^T (I - d d^T) v, a convex
+  // function of v as |d| <= 1: on the leaf a >= m = min_i a_i and r <= R = max_i r(V_i)
+  // (V_i the control points; v is their convex combination), so where m > 0,
+  //   |v|^2 = a^2 + r <= a^2 + 2 a Q <= (a + Q)^2,  Q = R / (2 m),
+  // and |v| <= a + Q, a polynomial of the column's degree (Q adds to every coefficient).
+  // With U_k = prod_j (a_kj + Q_kj), in J's space like L_k,
+  //   sj_k = s J / prod_j |v_kj| >= s J / U_k >= s min_i J_i / U_k,i.
+  // Q is of the order of the columns' spread squared, so the gap shrinks quadratically with
+  // the leaf, as the signed bound's, where J_lo over the largest norms (bound, also taken
+  // here) shrinks linearly. `upper` is lowered to sj at the leaf's corners.
+  // Errors: R covers the computed V_i's errors and the roundings of the projection
+  // (directional_columns); the shifted coefficients a_i + Q carry a's error plus one
+  // rounding of the sum; U_k's as L_k's.
+  double paired_bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
+    const std::size_t sj = in_.j.size();
+    const std::vector<int>& j_corners = layout_.j_tools->corners;
+    const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
+    const std::size_t corners = j_corners.size();
+    const std::uint32_t unusable = directional_columns(leaf, err, true);
+    const double j_lo = down(*std::min_element(leaf, leaf + sj) - err[0]);
+    double lower = kInf;
+    for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
+      const auto& fr = layout_.frames[k];
+      double norm_product = 1;
+      for (std::size_t j = 0; j < 3; ++j) norm_product = up(norm_product * ws_.norm_big[fr[j]]);
+      double frame_lower = j_lo > 0 ? down(s_lo * down(j_lo / norm_product)) : 0.0;
+      if (!(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]))) {
+        // min_i (J_i - e) / (U_i + e_U) without directed roundings (ratio_scan.hpp): each
+        // quotient within three roundings of the exact one, and a positive least one
+        // means every numerator is positive (rounding keeps signs).
+        const double el = frame_product(k);
+        const RatioScan scan = scan_ratios<true>(leaf, -err[0], ws_.product.data(), el, el, sj);
+        const double least = scan.extreme;
+        if (scan.least_den > 0 && least > 0 && least < kInf)
+          frame_lower = std::max(frame_lower, down(s_lo * down(down(least * (1 - 4 * kUnit)) -
+                                                               std::numeric_limits<double>::denorm_min())));
+      }
+      lower = std::min(lower, frame_lower);
+      // Upper bounds at the leaf's corners: s J / prod |v_kj| with J at most J + e and the
+      // norms at least their computed values minus spread.
+      for (std::size_t mi = 0; mi < corners; ++mi) {
+        const double j_hi = up(leaf[j_corners[mi]] + err[0]);
+        double norm_product = 1;
+        for (std::size_t j = 0; j < 3; ++j) norm_product = down(norm_product * ws_.corner_norm_lo[fr[j] * corners + mi]);
+        if (j_hi > 0 && norm_product > 0) upper = std::min(upper, up(s_hi * up(j_hi / norm_product)));
+      }
+    }
+    return lower;
+  }
+
+  // Per distinct frame column dc of the leaf: ws_.along_of[dc] = its control points' dot
+  // products with the unit vector d along their mean, ws_.big[dc] >= their magnitudes,
+  // ws_.along_err[dc] >= their errors, and bounds of |v| at the leaf's corners (above:
+  // corner_norm, below: corner_norm_lo) and on the whole leaf (norm_big). With `shifted`
+  // (paired_bound), along_of holds a_i + Q instead, its error and magnitude with it.
+  // Errors: a frame column's coordinates are within e (frame_error), so v . d (|d| <= 1) is
+  // within sqrt(3) e plus the dot product's rounding (gamma_3 sum |v_x d_x| <= 4u sqrt(3)
+  // max|v_x|). For R: the projection p = V - (V . d) d is computed within 16u |V| (the dot
+  // product, its product with d and the difference: about 11u |V| in all), I - d d^T moves
+  // V's error sqrt(3) e by no more (its norm is at most 1), and r(V) = |p|^2 + (V . d)^2 (1 -
+  // |d|^2) with 1 - |d|^2 <= 4e-15 for the d below.
+  // @return bit dc set where column dc is unusable (its mean vanishes; shifted: also a's
+  // coefficients not proven positive)
+  std::uint32_t directional_columns(const double* leaf, const std::array<double, 4>& err, bool shifted) const {
+    const std::vector<int>& j_corners = layout_.j_tools->corners;
     const std::size_t nd = layout_.distinct.size();
     const std::size_t corners = j_corners.size();
     ws_.big.resize(nd);
+    ws_.norm_big.resize(nd);
     ws_.along_err.resize(nd);
     ws_.corner_norm.resize(nd * corners);
+    ws_.corner_norm_lo.resize(nd * corners);
     if (ws_.along_of.size() < nd) ws_.along_of.resize(nd);
-    std::uint32_t unusable = 0;  // bit d: column d's mean vanishes
+    std::uint32_t unusable = 0;
     for (std::size_t dc = 0; dc < nd; ++dc) {
       const FrameColumn& f = layout_.distinct[dc];
       const auto c0 = static_cast<std::size_t>(f.column[0]);
@@ -366,67 +464,74 @@ class Quotient {
         const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
         double sum = 0;
         for (std::size_t x = 0; x < 3; ++x) sum += ws_.part[x * n + at] * ws_.part[x * n + at];
-        ws_.corner_norm[dc * corners + mi] = up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread);
+        const double norm = sqrt_rn(sum);
+        ws_.corner_norm[dc * corners + mi] = up(up(norm * (1 + 1e-12)) + spread);
+        ws_.corner_norm_lo[dc * corners + mi] = std::max(0.0, down(down(norm * (1 - 1e-12)) - spread));
       }
       const double len = sqrt_rn(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
       if (!(len > 0) || !(len < kInf)) {
         unusable |= 1u << dc;
+        ws_.norm_big[dc] = kInf;
         continue;
       }
       std::array<double, 3> d{};
       for (std::size_t x = 0; x < 3; ++x) d[x] = mean[x] / len * (1 - 1e-15);  // |d| <= 1
       std::vector<double>& along = ws_.along_of[dc];
       along.resize(n);
-      double big = 0;
+      double big = 0, big_square = 0, perp_square = 0, a_min = kInf;
       for (std::size_t i = 0; i < n; ++i) {
-        along[i] = ws_.part[i] * d[0] + ws_.part[n + i] * d[1] + ws_.part[2 * n + i] * d[2];
-        big = std::max(big, std::abs(along[i]));
+        const double v0 = ws_.part[i], v1 = ws_.part[n + i], v2 = ws_.part[2 * n + i];
+        const double a = v0 * d[0] + v1 * d[1] + v2 * d[2];
+        along[i] = a;
+        big = std::max(big, std::abs(a));
+        big_square = std::max(big_square, v0 * v0 + v1 * v1 + v2 * v2);
+        if (!shifted) continue;
+        a_min = std::min(a_min, a);
+        const double p0 = v0 - a * d[0], p1 = v1 - a * d[1], p2 = v2 - a * d[2];
+        perp_square = std::max(perp_square, p0 * p0 + p1 * p1 + p2 * p2);
       }
+      const double vn = up(sqrt_rn(big_square) * (1 + 1e-12));  // >= every computed |V_i|
       ws_.big[dc] = big;
+      ws_.norm_big[dc] = up(vn + spread);
       ws_.along_err[dc] = up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
-    }
-    double lower = kInf;
-    for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
-      const auto& fr = layout_.frames[k];
-      const bool usable = !(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]));
-      const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], ws_.big[fr[2]]};
-      const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], ws_.along_err[fr[2]]};
-      double frame_lower = -s_hi;  // Hadamard
-      if (usable) {
-        const QuotientLayout::TripleProduct& tp = layout_.triple[k];
-        ws_.product.resize(sj);
-        ws_.scratch.resize(static_cast<std::size_t>(tp.first->h_size()));
-        tp.first->multiply(ws_.along_of[fr[0]].data(), ws_.along_of[fr[1]].data(), ws_.scratch.data());
-        tp.second->multiply(ws_.scratch.data(), ws_.along_of[fr[2]].data(), ws_.product.data());
-        const double rr = tp.rounding;
-        const double mm = m[0] * m[1] * m[2];
-        const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
-        const double el = up((propagated + rr * mm) * (1 + 1e-10));
-        double least = 0;  // min(0, min_i J_i / L_i)
-        bool positive = true;
-        for (std::size_t i = 0; i < sj; ++i) {
-          const double den = down(ws_.product[i] - el);
-          if (!(den > 0)) {
-            positive = false;
-            break;
-          }
-          const double num = down(leaf[i] - err[0]);
-          if (num < 0) least = std::min(least, down(num / den));
-        }
-        if (positive) frame_lower = std::max(frame_lower, down(s_hi * least));
+      if (!shifted) continue;
+      // R from the largest |p_i| and |V_i| (r grows with both).
+      const double ev3 = up(kSqrt3 * ev);
+      const double pn = up(up(up(sqrt_rn(perp_square) * (1 + 1e-12)) + up(16 * kUnit * vn)) + ev3);
+      const double ve = up(vn + ev3);
+      const double r_max = up(up(pn * pn) + up(4e-15 * up(ve * ve)));
+      const double m = down(a_min - ws_.along_err[dc]);
+      if (!(m > 0) || !(r_max < kInf)) {
+        unusable |= 1u << dc;
+        continue;
       }
-      lower = std::min(lower, frame_lower);
-      // Upper bounds at the leaf's corners where J < 0 is certain: s J / prod |v_kj| with
-      // J at most J + e (negative) and the norms at most their computed values plus spread.
-      for (std::size_t mi = 0; mi < corners; ++mi) {
-        const double j_hi = up(leaf[j_corners[mi]] + err[0]);
-        if (!(j_hi < 0)) continue;
-        double norm_product = 1;
-        for (std::size_t j = 0; j < 3; ++j) norm_product = up(norm_product * ws_.corner_norm[fr[j] * corners + mi]);
-        upper = std::min(upper, up(s_lo * up(j_hi / norm_product)));
+      const double q = up(r_max / down(2 * m));
+      double shifted_big = 0;
+      for (double& a : along) {
+        a += q;
+        shifted_big = std::max(shifted_big, std::abs(a));
       }
+      ws_.big[dc] = shifted_big;
+      ws_.along_err[dc] = up(ws_.along_err[dc] + up(2 * kUnit * shifted_big));
     }
-    return lower;
+    return unusable;
+  }
+
+  // ws_.product = the product of frame k's three along_of vectors, in J's space; returns
+  // the bound of its coefficients' errors (the factors' propagated errors plus
+  // triple_product_rounding's bound).
+  double frame_product(std::size_t k) const {
+    const auto& fr = layout_.frames[k];
+    const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], ws_.big[fr[2]]};
+    const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], ws_.along_err[fr[2]]};
+    const QuotientLayout::TripleProduct& tp = layout_.triple[k];
+    ws_.product.resize(in_.j.size());
+    ws_.scratch.resize(static_cast<std::size_t>(tp.first->h_size()));
+    tp.first->multiply(ws_.along_of[fr[0]].data(), ws_.along_of[fr[1]].data(), ws_.scratch.data());
+    tp.second->multiply(ws_.scratch.data(), ws_.along_of[fr[2]].data(), ws_.product.data());
+    const double mm = m[0] * m[1] * m[2];
+    const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
+    return up((propagated + tp.rounding * mm) * (1 + 1e-10));
   }
 
   // Splits the leaf into the 2^dim children (child-major, stride() each) with their states
@@ -497,18 +602,30 @@ class Quotient {
   QuotientScratch& ws_;
 };
 
+// Which bound the leaves get: Quotient::bound (split into 2^dim children), signed_bound or
+// paired_bound (single bisections).
+enum class Pairing { none, signs, positive };
+
 QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
-                     bool signs, QualityBounds out);
+                     Pairing pairing, QualityBounds out);
 
 }  // namespace
 
+namespace {
+thread_local bool use_paired_stage = true;
+}  // namespace
+
+void scaled_jacobian_use_paired_stage(bool on) noexcept { use_paired_stage = on; }
+
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                              int max_splits) {
+                              int max_splits, int max_paired_splits) {
   QualityBounds out;
   out.lower = -kInf;
   out.upper = space.s_hi();
   if (!(down(*std::min_element(in.j.begin(), in.j.end()) - in.j_error) > 0)) return out;
-  return refine(space, in, tol, max_splits, false, out);
+  if (use_paired_stage && !layout_of(space, in).triple.empty())
+    return refine(space, in, tol, max_paired_splits, Pairing::positive, out);
+  return refine(space, in, tol, max_splits, Pairing::none, out);
 }
 
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
@@ -516,16 +633,16 @@ QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const Quo
   QualityBounds out;
   out.lower = -kInf;
   out.upper = 0;  // J <= 0 at a point, where sj <= 0
-  if (layout_of(space, in).triple.empty()) return out;  // L_k outside J's space (pyramids)
-  return refine(space, in, tol, max_splits, true, out);
+  if (layout_of(space, in).triple.empty()) return out;  // L_k outside J's space (2D)
+  return refine(space, in, tol, max_splits, Pairing::signs, out);
 }
 
 namespace {
 
-// Best-first refinement of the leaves' bounds (bound, or signed_bound when `signs`), from
-// `out` holding the bounds known before.
+// Best-first refinement of the leaves' bounds (see Pairing), from `out` holding the bounds
+// known before.
 QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
-                     bool signs, QualityBounds out) {
+                     Pairing pairing, QualityBounds out) {
   thread_local QuotientScratch scratch;
   const Quotient q(space, in, scratch);
   const std::size_t stride = q.stride();
@@ -547,7 +664,9 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   const auto push = [&](int slot) {
     const auto s = static_cast<std::size_t>(slot);
     const double* leaf = pool.data() + s * stride;
-    const double lo = signs ? q.signed_bound(leaf, pool_err[s], out.upper) : q.bound(leaf, pool_err[s], out.upper);
+    const double lo = pairing == Pairing::signs      ? q.signed_bound(leaf, pool_err[s], out.upper)
+                      : pairing == Pairing::positive ? q.paired_bound(leaf, pool_err[s], out.upper)
+                                                     : q.bound(leaf, pool_err[s], out.upper);
     if (up(out.upper - lo) <= tol) {
       settled = std::min(settled, lo);  // stays good enough: upper only decreases
       free_slots.push_back(slot);
@@ -560,13 +679,17 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   // The gap shrinks about linearly with the subdomain: a root far from the tolerance would
   // need more splits than the products of the full bounds cost (scaled_jacobian.cpp,
   // kQuotientSplits), so only a root within kReachable tolerances is refined.
-  if (!signs && !heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol) max_splits = 0;
+  if (pairing == Pairing::none && !heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol)
+    max_splits = 0;
+  if (pairing == Pairing::positive && !heap.empty() && up(out.upper - heap.front().lower) > kPairedReachable * tol)
+    max_splits = 0;
   thread_local std::vector<double> parent;
   parent.resize(stride);
   std::array<double, 4> child_err{};
-  // The signed bound refines by single bisections (as the full bounds do), `levels` of
+  // The paired bounds refine by single bisections (as the full bounds do), `levels` of
   // them counting as one split.
-  const long levels = signs ? q.levels() : 1;
+  const bool halving = pairing != Pairing::none;
+  const long levels = halving ? q.levels() : 1;
   long steps = 0;
   while (!heap.empty()) {
     const Leaf top = heap.front();
@@ -579,7 +702,7 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
     const std::array<double, 4> parent_err = pool_err[ts];
     const BisectionState parent_state = states[ts];
     free_slots.push_back(top.slot);
-    if (signs)
+    if (halving)
       q.halve(parent.data(), parent_err, parent_state, children, child_states, child_err);
     else
       q.split(parent.data(), parent_err, parent_state, children, child_states, child_err);

@@ -89,7 +89,7 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
 /// The signed first stage on its own (tests): bounds of sj(E) of a 3D element where J <= 0
 /// was found at a point (the caller's claim: upper starts at 0), from J's coefficients with
 /// their signs and the columns (scaled_jacobian_quotient.hpp), refined by at most max_splits
-/// splits; lower = -inf for pyramids.
+/// splits.
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
                                            int max_splits);
 
@@ -100,6 +100,11 @@ QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<co
 /// pyramids (trilinear_hex_sj.hpp, linear_pyramid_sj.hpp), to compare them with the
 /// general path.
 void scaled_jacobian_use_straight_path(bool on) noexcept;
+
+/// Tests only: switch off (on by default), in the calling thread, the paired bound of the
+/// first stage of valid 3D elements (scaled_jacobian_quotient.cpp, paired_bound): the stage
+/// then bounds J's least coefficient over the largest norms alone, as in 2D.
+void scaled_jacobian_use_paired_stage(bool on) noexcept;
 
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian
 /// engine (jacobian_bounds, any goal: only the sign of min J is used), as check_mesh has
