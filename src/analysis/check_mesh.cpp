@@ -33,6 +33,7 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/stage_clock.hpp"
+#include "analysis/straight_tet_mu.hpp"
 #include "analysis/worker_threads.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
@@ -48,6 +49,7 @@ namespace {
 // (tri_h0.4_o4: 0.34 -> 0.29 ms with 64 instead of 256).
 constexpr std::size_t kFastChunk = kLinearChunk;
 constexpr std::size_t kChunk = 64;
+constexpr std::size_t kRow = kChunk + 8;  // straight-sided chunks' vertex rows, a cache line apart
 static_assert(kChunk <= kFastChunk);
 static_assert(kCheckBatch % kFastChunk == 0 && kCheckBatch % kChunk == 0);
 
@@ -358,6 +360,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     std::vector<std::size_t> rest;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
+    std::vector<QualityBounds> lane_mu;
+    unsigned lane_mu_done[kLinearChunk / 8];
     const Buffer own = batched ? Buffer{} : make_buffer(kFastChunk);  // the largest chunk
     for (;;) {
       const std::size_t c = next_chunk.fetch_add(1, std::memory_order_relaxed);
@@ -414,9 +418,14 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               ++qc.computed;
               if (!out.tolerance_met) ++qc.tolerance_not_met;
             };
-            // mu and the scaled Jacobian of an element whose validity is known.
-            const auto qualities = [&](std::size_t index, const double* xe, Validity v, const KnownMargin* known) {
-              if (want_mu)
+            // mu and the scaled Jacobian of an element whose validity is known (mu given
+            // when the chunk's lanes computed it).
+            const auto qualities = [&](std::size_t index, const double* xe, Validity v, const KnownMargin* known,
+                                       const QualityBounds* mu_given = nullptr) {
+              if (want_mu && mu_given) {
+                mu[index] = *mu_given;
+                ++st.mu.computed;
+              } else if (want_mu)
                 quality(mu_supported(type), mu[index], st.mu, xe, known,
                         [v](const ElementType& t, std::span<const double> x, const QualityOptions& q, bool planar,
                             const KnownMargin* k) { return mu_bounds_given(t, x, q, planar, v, k); });
@@ -436,23 +445,55 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
+            // mu of a chunk's valid straight-sided tetrahedra (decided by linear_validity_chunk,
+            // vertices in `soa` by vertex and axis, rows of `row`; betas: the straight-sided
+            // margins of the columns, 3 per element, or none for first-order ones), 8 at a
+            // time (straight_tet_mu.hpp): bit i % 8 of lane_mu_done[i / 8] set where
+            // lane_mu[i] holds element i's, as mu_bounds_given would compute it.
+            const auto tet_mu_lanes = [&](const ElementType& t, std::size_t row, const double* betas, std::size_t count) {
+              lane_mu.resize(kLinearChunk);
+              for (std::size_t i0 = 0; i0 < count; i0 += 8) {
+                Lanes<8> edges[9], margin[3] = {};
+                unsigned valid = 0;
+                for (std::size_t l = 0; l < 8; ++l) {
+                  const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
+                  for (std::size_t v = 0; v < 9; ++v)  // vertex v / 3 + 1 minus vertex 0, axis v % 3
+                    edges[v][l] = soa[(3 + v) * row + i] - soa[(v % 3) * row + i];
+                  for (std::size_t c = 0; c < 3 && betas; ++c) margin[c][l] = betas[3 * i + c];
+                  if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid &&
+                      (!betas || std::isfinite(margins[i])))
+                    valid |= 1u << l;
+                }
+                lane_mu_done[i0 / 8] =
+                    valid != 0 ? valid & straight_tet_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0) : 0u;
+              }
+            };
+            const auto lane_mu_of = [&](std::size_t i) {
+              return ((lane_mu_done[i / 8] >> (i % 8)) & 1u) != 0 ? &lane_mu[i] : nullptr;
+            };
             // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp),
             // which never takes the exact fallback: the bookkeeping, and mu and the scaled
             // Jacobian from the element's nodes (with the chunk's straight-sided margin, if
             // it has one).
             const auto finish_first_order = [&](std::size_t index, std::size_t element, const JacobianBounds& b,
-                                                double ticks, const KnownMargin* known) {
+                                                double ticks, const KnownMargin* known,
+                                                const QualityBounds* mu_given = nullptr) {
               ElementCheck& ec = elements[index];
               ec.bounds = b;
               ec.analysed = true;
               st.add(b.stage, b.validity, ticks);
+              if (mu_given && !want_sj) {
+                mu[index] = *mu_given;
+                ++st.mu.computed;
+                return;
+              }
               if (!want_mu && !want_sj) return;
               const auto conn = blk.element(element);
               element_nodes.resize(nn * 3);
               for (std::size_t k = 0; k < nn; ++k)
                 for (std::size_t j = 0; j < 3; ++j)
                   element_nodes[k * 3 + j] = mesh.coords[3 * static_cast<std::size_t>(conn[k]) + j];
-              qualities(index, element_nodes.data(), b.validity, known);
+              qualities(index, element_nodes.data(), b.validity, known, mu_given);
             };
             if (fast != LinearKind::none) {
               // First-order fast path (linear_jacobian.hpp): the coefficients straight from
@@ -474,13 +515,16 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               fast_bounds.resize(ch.count);
               linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
               const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
+              const bool tet_lanes = want_mu && fast == LinearKind::tetrahedron && mu_supported(type);
+              if (tet_lanes) tet_mu_lanes(type, kLinearRow, nullptr, ch.count);  // outside the stage times
               nodes.resize(nn * 3);
               errors.resize(1);
               for (std::size_t i = 0; i < ch.count; ++i) {
                 ElementCheck& ec = elements[ch.out + i];
                 const auto conn = blk.element(ch.first + i);
                 if (decided[i]) {
-                  finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share, nullptr);
+                  finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share, nullptr,
+                                     tet_lanes ? lane_mu_of(i) : nullptr);
                   continue;
                 }
                 const std::uint64_t te = stage_ticks();
@@ -507,6 +551,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // element by element.
               std::size_t left = 0;
               rest.resize(ch.count);
+              bool tet_lanes = false;
               if (const StraightSidedMargin* straight = straight_of[ch.block].get()) {
                 const std::uint64_t ts = stage_ticks();
                 const double* coords = mesh.coords.data();
@@ -517,7 +562,6 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                                   want_mu || want_sj ? betas.data() : nullptr);
                 if (std::any_of(margins.begin(), margins.begin() + static_cast<std::ptrdiff_t>(ch.count),
                                 [](double m) { return std::isfinite(m); })) {
-                  constexpr std::size_t kRow = kChunk + 8;  // rows a cache line apart beyond the chunk
                   const auto nv = static_cast<std::size_t>(linear_num_vertices(straight->kind()));
                   const std::size_t axes = type.dim == 2 ? 2 : 3;  // planar 2D reads x and y
                   soa.resize(nv * 3 * kRow);
@@ -532,10 +576,12 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   fast_bounds.resize(ch.count);
                   linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
                                         margins.data(), kRow);
+                  tet_lanes = want_mu && straight->kind() == LinearKind::tetrahedron && mu_supported(type);
                 } else {
                   std::fill(decided, decided + ch.count, false);  // a chunk of curved elements
                 }
                 const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
+                if (tet_lanes) tet_mu_lanes(type, kRow, betas.data(), ch.count);  // outside the stage times
                 for (std::size_t i = 0; i < ch.count; ++i) {
                   if (!decided[i]) {
                     rest[left++] = i;
@@ -545,7 +591,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   known.margin = margins[i];
                   std::copy_n(betas.begin() + static_cast<std::ptrdiff_t>(3 * i), 3, known.beta.begin());
                   finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share,
-                                     want_mu || want_sj ? &known : nullptr);
+                                     want_mu || want_sj ? &known : nullptr, tet_lanes ? lane_mu_of(i) : nullptr);
                 }
               } else {
                 for (std::size_t i = 0; i < ch.count; ++i) rest[left++] = i;

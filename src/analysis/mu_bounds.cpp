@@ -21,6 +21,7 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
+#include "analysis/straight_tet_mu.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/error.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -115,6 +116,16 @@ bool handled_family(ElementFamily f) {
   }
 }
 
+// mu's bounds from R's, or nothing when their gap exceeds tol.
+std::optional<QualityBounds> mu_from_ratio(double r_lower, double r_upper, double tol) {
+  QualityBounds out;
+  out.lower = sqrt_down(r_lower);
+  out.upper = sqrt_up(r_upper);
+  out.tolerance_met = out.upper - out.lower <= tol;
+  if (!out.tolerance_met) return std::nullopt;
+  return out;
+}
+
 // A straight-sided simplex (tetrahedron; triangle in a plane z = const; straight_sided.hpp):
 // its columns are the edges a_c = x_c - x_0 within beta_c everywhere, so W = J_p Jinv lies
 // entrywise within delta = max_j sum_c |Jinv_cj| (beta_c + 8u max|a_c|) (the edges' and the
@@ -132,6 +143,17 @@ std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span
   if (!simplex) return std::nullopt;
   std::array<double, 3> beta{0, 0, 0};
   if (type.order > 1 && !(straight_margin_of(type, x.data(), known, beta) < kInf)) return std::nullopt;
+  if (type.family == ElementFamily::tetrahedron) {
+    // The closed form in lanes (straight_tet_mu.hpp), the element in both: the same bounds
+    // as the check's chunks of eight; where it fails, the general closed form below.
+    Lanes<2> edges[9], margins[3];
+    for (std::size_t c = 0; c < 3; ++c) {
+      margins[c] = broadcast_lanes<2>(beta[c]);
+      for (std::size_t j = 0; j < 3; ++j) edges[3 * c + j] = broadcast_lanes<2>(x[3 * (c + 1) + j] - x[j]);
+    }
+    const StraightTetRatio<2> r = straight_tet_ratio<2>(edges, margins, space.ideal_inverse());
+    if ((r.ok & 1u) != 0) return mu_from_ratio(r.lower[0], r.upper[0], tol);
+  }
   const auto dim = static_cast<std::size_t>(type.dim);
   double a[3][3] = {}, a_max[3] = {0, 0, 0};
   for (std::size_t c = 0; c < dim; ++c)
@@ -155,17 +177,26 @@ std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span
   delta = next_up(delta * (1 + 1e-12));
   if (!(delta < kInf)) return std::nullopt;
   const RatioBounds ratio = constant_ratio_bounds(space, w, delta);
-  QualityBounds out;
-  out.lower = sqrt_down(ratio.lower);
-  out.upper = sqrt_up(ratio.upper);
-  out.tolerance_met = out.upper - out.lower <= tol;
-  if (!out.tolerance_met) return std::nullopt;
-  return out;
+  return mu_from_ratio(ratio.lower, ratio.upper, tol);
 }
 
 }  // namespace
 
 void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
+
+unsigned straight_tet_mu_lanes(const ElementType& type, const Lanes<8>* edges, const Lanes<8>* margins, double tol,
+                               QualityBounds* out) {
+  if (!mu_constant_path_enabled()) return 0;
+  const StraightTetRatio<8> r = straight_tet_ratio<8>(edges, margins, mu_space(type).ideal_inverse());
+  unsigned done = 0;
+  for (int l = 0; l < 8; ++l)
+    if ((r.ok >> l) & 1u)
+      if (const auto mu = mu_from_ratio(r.lower[l], r.upper[l], tol)) {
+        out[l] = *mu;
+        done |= 1u << l;
+      }
+  return done;
+}
 
 bool mu_supported(const ElementType& type) noexcept {
   return handled_family(type.family) && type.has_lagrange_basis && type.order >= 1 &&

@@ -1,0 +1,150 @@
+// The lane-parallel closed form of mu for straight-sided tetrahedra
+// (src/analysis/straight_tet_mu.hpp): against the singular values of W in long double
+// (an oracle sharing no code with it), lane by lane the same whatever the lane, and in the
+// check (8 elements at a time) bit for bit what mu_bounds gives each element alone.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <random>
+
+#include "analysis/lane_vector.hpp"
+#include "analysis/mu_space.hpp"
+#include "analysis/straight_tet_mu.hpp"
+#include "jacobian_test_util.hpp"
+#include "quadval/check_report.hpp"
+#include "quadval/element_type.hpp"
+#include "quadval/lagrange_basis.hpp"
+#include "quadval/mu_bounds.hpp"
+
+namespace quadval {
+namespace {
+
+using Matrix3l = Eigen::Matrix<long double, 3, 3>;
+
+// R = (sigma_min / sigma_max)^2 of W = [edges] Jinv, in long double.
+long double exact_ratio(const double* edges, const std::array<double, 9>& jinv) {
+  Matrix3l a, j;
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 3; ++k) {
+      a(k, c) = edges[3 * c + k];  // column c: edge c
+      j(c, k) = jinv[static_cast<std::size_t>(c * 3 + k)];
+    }
+  const Eigen::JacobiSVD<Matrix3l> svd(a * j);
+  const auto s = svd.singularValues();
+  return (s(2) / s(0)) * (s(2) / s(0));
+}
+
+// Edges of a random tetrahedron: well shaped, stretched, nearly flat or with a nearly
+// vanishing edge, at scales from 1e-9 to 1e6.
+std::array<double, 9> random_edges(int e, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  const double scale = e % 7 == 0 ? 1e-9 : e % 11 == 0 ? 1e6 : 1;
+  std::array<double, 9> a{};
+  for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t k = 0; k < 3; ++k) a[3 * c + k] = scale * ((c == k ? 1.0 : 0.0) + 0.6 * u(rng));
+  if (e % 5 == 1)  // nearly flat: edge 2 close to a combination of the others
+    for (std::size_t k = 0; k < 3; ++k) a[6 + k] = 0.4 * a[k] + 0.5 * a[3 + k] + scale * 1e-5 * u(rng);
+  if (e % 5 == 2)  // stretched along one axis
+    for (std::size_t c = 0; c < 3; ++c) a[3 * c] *= 50;
+  if (e % 13 == 3)  // one edge almost nothing
+    for (std::size_t k = 0; k < 3; ++k) a[k] *= 1e-7;
+  return a;
+}
+
+TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
+  std::mt19937 rng(5150);
+  const std::array<double, 9>& jinv = mu_space(*find_element_type(4)).ideal_inverse();
+  int ok = 0, total = 0;
+  for (int block = 0; block < 400; ++block) {
+    std::array<std::array<double, 9>, 8> edges;
+    std::array<double, 8> margin{};
+    Lanes<8> a[9], beta[3];
+    for (int l = 0; l < 8; ++l) {
+      edges[static_cast<std::size_t>(l)] = random_edges(block * 8 + l, rng);
+      // Half the blocks with a straight-sided margin on the columns (higher-order nodes).
+      margin[static_cast<std::size_t>(l)] = block % 2 == 0 ? 0.0 : 1e-9 * std::abs(edges[static_cast<std::size_t>(l)][0]);
+      for (int v = 0; v < 9; ++v) a[v][l] = edges[static_cast<std::size_t>(l)][static_cast<std::size_t>(v)];
+      for (int c = 0; c < 3; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
+    }
+    const StraightTetRatio<8> r = straight_tet_ratio<8>(a, beta, jinv);
+    for (int l = 0; l < 8; ++l) {
+      ++total;
+      const auto& x = edges[static_cast<std::size_t>(l)];
+      // The same element alone, in both lanes of two: the same bits.
+      Lanes<2> a2[9], b2[3];
+      for (int v = 0; v < 9; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
+      for (int c = 0; c < 3; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
+      const StraightTetRatio<2> alone = straight_tet_ratio<2>(a2, b2, jinv);
+      ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * 8 + l;
+      if (((r.ok >> l) & 1u) == 0) continue;
+      ++ok;
+      EXPECT_EQ(r.lower[l], alone.lower[0]);
+      EXPECT_EQ(r.upper[l], alone.upper[0]);
+      const long double exact = exact_ratio(x.data(), jinv);
+      EXPECT_LE(r.lower[l], exact * (1 + 1e-15L)) << "element " << block * 8 + l;
+      EXPECT_GE(r.upper[l], exact * (1 - 1e-15L)) << "element " << block * 8 + l;
+      EXPECT_LE(r.lower[l], r.upper[l]);
+      // Tight: to rounding without a margin, within a few margins (relative 1e-9) with one.
+      const double gap = margin[static_cast<std::size_t>(l)] == 0 ? 1e-7 : 1e-4;
+      if (exact > 1e-3L) {
+        EXPECT_LE(r.upper[l] - r.lower[l], gap * static_cast<double>(exact)) << "element " << block * 8 + l;
+      }
+    }
+  }
+  EXPECT_GT(ok, total * 3 / 4);  // the rest: nearly degenerate, left to the general path
+}
+
+// Tetrahedra of `type` at random: straight-sided (edge nodes straight, off by a
+// rounding-sized deviation, which gives a margin) or curved, some inverted.
+std::vector<std::vector<double>> random_tetrahedra(const ElementType& type, int count, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<std::vector<double>> elements;
+  for (int e = 0; e < count; ++e) {
+    const auto a = random_edges(e, rng);
+    const double origin[3] = {u(rng), u(rng), u(rng)};
+    const double sign = e % 6 == 4 ? -1 : 1;
+    const double deviation = e % 4 == 0 ? 0.0 : e % 4 == 1 ? 1e-13 : e % 4 == 2 ? 1e-9 : 1e-2;
+    std::vector<double> x;
+    for (const RefPoint& p : reference_nodes(type))
+      for (std::size_t k = 0; k < 3; ++k) {
+        double v = origin[k];
+        for (std::size_t c = 0; c < 3; ++c) v += sign * p[c] * a[3 * c + k];
+        const bool vertex = x.size() < 12;
+        x.push_back(vertex ? v : v + deviation * std::abs(a[k]) * u(rng));
+      }
+    elements.push_back(std::move(x));
+  }
+  return elements;
+}
+
+// The check's chunks (mu of the valid straight-sided tetrahedra 8 at a time) give each
+// element exactly what mu_bounds gives it alone, the fallbacks included, for first-order
+// tetrahedra and for quadratic and cubic ones (straight, with a margin, or curved).
+TEST(StraightTetMu, CheckChunksMatchMuBoundsBitForBit) {
+  std::mt19937 rng(77);
+  for (const int id : {4, 11, 29}) {
+    const ElementType& type = *find_element_type(id);
+    SCOPED_TRACE(std::string(type.name));
+    const auto elements = random_tetrahedra(type, 1500, rng);
+    CheckOptions o;
+    o.measure = CheckMeasure::mu;
+    o.threads = 2;
+    const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
+    ASSERT_EQ(r.mu.size(), elements.size());
+    QualityOptions q;
+    q.abs_tol = o.quality_abs_tol;
+    int valid = 0;
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      const QualityBounds alone = mu_bounds(type, elements[e], q, false);
+      EXPECT_EQ(r.mu[e].lower, alone.lower) << "element " << e;
+      EXPECT_EQ(r.mu[e].upper, alone.upper) << "element " << e;
+      EXPECT_EQ(r.mu[e].tolerance_met, alone.tolerance_met) << "element " << e;
+      if (alone.lower > 0) ++valid;
+    }
+    EXPECT_GT(valid, 700);
+  }
+}
+
+}  // namespace
+}  // namespace quadval
