@@ -39,8 +39,9 @@ constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 double down(double x) { return next_down(x); }
 double up(double x) { return next_up(x); }
-// Splits of J and the columns before the products, 2D (the quotient stage, which refines
-// only a root within twice the tolerance). Measured on the shared curved meshes at --tol 1e-2:
+// Splits of J and the columns before the products, where the paired bound does not apply
+// (lines, and the tests' switch; the quotient stage refines only a root within twice the
+// tolerance). Measured on the shared curved meshes at --tol 1e-2:
 // 16 splits of any root made linear hexahedra 10x and quadratic quadrangles 5x slower (the
 // gap of a distorted element closes only linearly); 4 near the tolerance gain a little
 // (warped_pyramid_o2: 163 elements settled by one split). A root within 4 tolerances
@@ -50,14 +51,16 @@ double up(double x) { return next_up(x); }
 // and hexahedra: hex_box 10% faster, but mixed_h0.6_o2 20% and warped_hexahedron_o2 25%
 // slower.
 constexpr int kQuotientSplits = 4;
-// Splits of the paired first stage of valid 3D elements (single bisections, `levels` of
-// them one split; scaled_jacobian_quotient.cpp, paired_bound). sj of the valid elements,
-// one thread, a per-element harness, best of 5, unpaired stage -> 4, 8, 16 splits:
-// warped_pyramid_o2 71 -> 35 ms at any (its 1,290 all settled by 8, none by the products
-// of (6r + 1)^3 coefficients), mixed_h0.6_o2 9.9 -> 7.4 ms, warped_tetrahedron_o3 17.2 ->
-// 15.5 ms, warped_prism_o2 2.4 -> 2.1 ms, the others within noise.
+// Splits of the paired first stage of valid 3D and planar 2D elements (single bisections,
+// `levels` of them one split; scaled_jacobian_quotient.cpp, paired_bound). sj of the valid
+// elements, one thread, a per-element harness, best of 5, unpaired stage -> 4, 8, 16
+// splits: warped_pyramid_o2 71 -> 35 ms at any (its 1,290 all settled by 8, none by the
+// products of (6r + 1)^3 coefficients), mixed_h0.6_o2 9.9 -> 7.4 ms, warped_tetrahedron_o3
+// 17.2 -> 15.5 ms, warped_prism_o2 2.4 -> 2.1 ms, the others within noise. In 2D (with the
+// signed stage), CLI sj on 2 threads, medians of 9: tri_h0.4_o4 1.08 -> 0.90 ms,
+// quad_h0.4_o2 0.71 -> 0.67 ms.
 constexpr int kPairedSplits = 8;
-// Splits of the signed first stage of 3D elements where J <= 0 was found
+// Splits of the signed first stage of 3D and planar 2D elements where J <= 0 was found
 // (scaled_jacobian_quotient.hpp). Invalid elements' sj, one thread, a per-element harness,
 // full path alone -> 2, 4, 8, 16 splits first (one run each, noisy): warped_hexahedron_o2
 // 13.4 -> 5.3, 6.7, 6.5, 7.1 ms (all 156 settled by 2); warped_prism_o2 29.9 -> 23.8, 19.2,
@@ -557,13 +560,13 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
 
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
                                            int max_splits) {
-  QV_ASSERT(scaled_jacobian_supported(type) && type.dim == 3 && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
+  QV_ASSERT(scaled_jacobian_supported(type) && type.dim >= 2 && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
             "signed stage of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
   thread_local Polys polys;
   thread_local std::vector<double> values;
-  columns_and_jacobian(space, nodes, false, polys, values);
-  return signed_quotient_bounds(space, quotient_input(polys, 3), tol, max_splits);
+  columns_and_jacobian(space, nodes, /*planar=*/type.dim == 2, polys, values);
+  return signed_quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits);
 }
 
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
@@ -607,7 +610,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   }
   // Where J <= 0 was found (3D), the signed first stage likewise: J's coefficients with
   // their signs over products of the columns along their mean directions.
-  if (v == Validity::invalid && dim == 3) {
+  if (v == Validity::invalid && (dim == 3 || (dim == 2 && !area))) {
     quick = signed_quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
                                    std::min(kSignedSplits, options.max_subdivisions));
     if (quick.tolerance_met) return quick;

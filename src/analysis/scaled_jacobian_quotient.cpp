@@ -106,9 +106,10 @@ struct QuotientLayout {
   std::size_t stride = 0;
   std::vector<FrameColumn> distinct;              // frame columns, first weight positive
   std::vector<std::array<std::size_t, 3>> frames;  // per frame: its columns in `distinct`
-  // Per frame, for the signed bound (3D, when the three columns' product lies in J's
-  // space): the tables of (v_1 v_2) and of (v_1 v_2) v_3, and the relative rounding bound of
-  // that triple product (triple_product_rounding); empty otherwise.
+  // Per frame, for the paired bounds (3D and 2D, when the columns' product lies in J's
+  // space): the tables of (v_1 v_2) and, in 3D, of (v_1 v_2) v_3, and the relative rounding
+  // bound of that product (BernsteinProduct::rounding, triple_product_rounding); empty
+  // otherwise.
   struct TripleProduct {
     const BernsteinProduct* first = nullptr;
     const BernsteinProduct* second = nullptr;
@@ -157,14 +158,15 @@ QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput
     }
     q.frames.push_back(slots);
   }
-  // The triple products' tables, where the columns' degrees add up to J's.
-  if (dim == 3) {
+  // The tables of the products of a frame's columns (two in 2D, three in 3D), where the
+  // columns' degrees add up to J's.
+  if (dim >= 2) {
     const std::vector<FactorDegree>& j = *in.j_degrees;
     std::vector<FactorDegree> sum(j.size());
     bool same = true;
     for (std::size_t f = 0; f < j.size() && same; ++f) {
       sum[f] = {j[f].dim, 0};
-      for (std::size_t c = 0; c < 3; ++c) {
+      for (std::size_t c = 0; c < dim; ++c) {
         const std::vector<FactorDegree>& d = *in.col_degrees[c];
         same = same && d.size() == j.size() && d[f].dim == j[f].dim;
         if (same) sum[f].degree += d[f].degree;
@@ -175,11 +177,14 @@ QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput
       for (const auto& fr : q.frames) {
         const auto& d0 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[0]].column[0])];
         const auto& d1 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[1]].column[0])];
-        const auto& d2 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[2]].column[0])];
         QuotientLayout::TripleProduct t;
         t.first = &bernstein_product(d0, d1);
-        t.second = &bernstein_product(product_degrees(d0, d1), d2);
-        t.rounding = triple_product_rounding(*t.first, *t.second);
+        t.rounding = t.first->rounding(1);
+        if (dim == 3) {
+          const auto& d2 = *in.col_degrees[static_cast<std::size_t>(q.distinct[fr[2]].column[0])];
+          t.second = &bernstein_product(product_degrees(d0, d1), d2);
+          t.rounding = triple_product_rounding(*t.first, *t.second);
+        }
         q.triple.push_back(t);
       }
   }
@@ -322,7 +327,7 @@ class Quotient {
     return lower;
   }
 
-  // On an element not proven valid (3D): a certified lower bound of sj on the leaf from J's
+  // On an element not proven valid (3D, planar 2D): a certified lower bound of sj on the leaf from J's
   // coefficients, their signs included; `upper` is lowered to sj at the leaf's corners where
   // J < 0 there. Per frame k, L_k = prod_j (v_kj . d_kj), d_kj a unit vector along the mean
   // of v_kj's control points: |v . d| <= |v|, so where L_k's coefficients are positive (their
@@ -344,7 +349,7 @@ class Quotient {
     for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
       const auto& fr = layout_.frames[k];
       double frame_lower = -s_hi;  // Hadamard
-      if (!(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]))) {
+      if (usable(k, unusable)) {
         // min(0, min_i (J_i - e) / (L_i - e_L)) without directed roundings (ratio_scan.hpp):
         // each quotient within three roundings of the exact one; rounding keeps signs.
         const double el = frame_product(k);
@@ -362,14 +367,14 @@ class Quotient {
         const double j_hi = up(leaf[j_corners[mi]] + err[0]);
         if (!(j_hi < 0)) continue;
         double norm_product = 1;
-        for (std::size_t j = 0; j < 3; ++j) norm_product = up(norm_product * ws_.corner_norm[fr[j] * corners + mi]);
+        for (std::size_t j = 0; j < dim_; ++j) norm_product = up(norm_product * ws_.corner_norm[fr[j] * corners + mi]);
         upper = std::min(upper, up(s_lo * up(j_hi / norm_product)));
       }
     }
     return lower;
   }
 
-  // On an element where J > 0 is proven (3D): the same pairing with an upper bound of the
+  // On an element where J > 0 is proven (3D, planar 2D): the same pairing with an upper bound of the
   // norms. With a = v . d (d as above) and r = |v|^2 - a^2 = v^T (I - d d^T) v, a convex
   // function of v as |d| <= 1: on the leaf a >= m = min_i a_i and r <= R = max_i r(V_i)
   // (V_i the control points; v is their convex combination), so where m > 0,
@@ -394,9 +399,9 @@ class Quotient {
     for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
       const auto& fr = layout_.frames[k];
       double norm_product = 1;
-      for (std::size_t j = 0; j < 3; ++j) norm_product = up(norm_product * ws_.norm_big[fr[j]]);
+      for (std::size_t j = 0; j < dim_; ++j) norm_product = up(norm_product * ws_.norm_big[fr[j]]);
       double frame_lower = j_lo > 0 ? down(s_lo * down(j_lo / norm_product)) : 0.0;
-      if (!(unusable & (1u << fr[0] | 1u << fr[1] | 1u << fr[2]))) {
+      if (usable(k, unusable)) {
         // min_i (J_i - e) / (U_i + e_U) without directed roundings (ratio_scan.hpp): each
         // quotient within three roundings of the exact one, and a positive least one
         // means every numerator is positive (rounding keeps signs).
@@ -413,7 +418,7 @@ class Quotient {
       for (std::size_t mi = 0; mi < corners; ++mi) {
         const double j_hi = up(leaf[j_corners[mi]] + err[0]);
         double norm_product = 1;
-        for (std::size_t j = 0; j < 3; ++j) norm_product = down(norm_product * ws_.corner_norm_lo[fr[j] * corners + mi]);
+        for (std::size_t j = 0; j < dim_; ++j) norm_product = down(norm_product * ws_.corner_norm_lo[fr[j] * corners + mi]);
         if (j_hi > 0 && norm_product > 0) upper = std::min(upper, up(s_hi * up(j_hi / norm_product)));
       }
     }
@@ -517,21 +522,33 @@ class Quotient {
     return unusable;
   }
 
-  // ws_.product = the product of frame k's three along_of vectors, in J's space; returns
-  // the bound of its coefficients' errors (the factors' propagated errors plus
-  // triple_product_rounding's bound).
+  // ws_.product = the product of frame k's along_of vectors (dim of them), in J's space;
+  // returns the bound of its coefficients' errors (the factors' propagated errors plus the
+  // products' rounding: BernsteinProduct::rounding, triple_product_rounding in 3D).
   double frame_product(std::size_t k) const {
     const auto& fr = layout_.frames[k];
-    const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], ws_.big[fr[2]]};
-    const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], ws_.along_err[fr[2]]};
+    const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], dim_ == 3 ? ws_.big[fr[2]] : 1.0};
+    const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], dim_ == 3 ? ws_.along_err[fr[2]] : 0.0};
     const QuotientLayout::TripleProduct& tp = layout_.triple[k];
     ws_.product.resize(in_.j.size());
-    ws_.scratch.resize(static_cast<std::size_t>(tp.first->h_size()));
-    tp.first->multiply(ws_.along_of[fr[0]].data(), ws_.along_of[fr[1]].data(), ws_.scratch.data());
-    tp.second->multiply(ws_.scratch.data(), ws_.along_of[fr[2]].data(), ws_.product.data());
+    if (dim_ == 2) {
+      tp.first->multiply(ws_.along_of[fr[0]].data(), ws_.along_of[fr[1]].data(), ws_.product.data());
+    } else {
+      ws_.scratch.resize(static_cast<std::size_t>(tp.first->h_size()));
+      tp.first->multiply(ws_.along_of[fr[0]].data(), ws_.along_of[fr[1]].data(), ws_.scratch.data());
+      tp.second->multiply(ws_.scratch.data(), ws_.along_of[fr[2]].data(), ws_.product.data());
+    }
+    // 2D: m_2 = 1 and e_2 = 0 make these the bounds of the two-factor product.
     const double mm = m[0] * m[1] * m[2];
     const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
     return up((propagated + tp.rounding * mm) * (1 + 1e-10));
+  }
+
+  // Whether frame k's columns are all usable (directional_columns' bits).
+  bool usable(std::size_t k, std::uint32_t unusable) const {
+    for (std::size_t j = 0; j < dim_; ++j)
+      if (unusable & (1u << layout_.frames[k][j])) return false;
+    return true;
   }
 
   // Splits the leaf into the 2^dim children (child-major, stride() each) with their states

@@ -11,7 +11,7 @@
 // parallelograms, parallelepipeds), and its gap shrinks linearly with the subdomain: J and
 // the columns (degree n, far smaller than the degree 2n of N and D_k) are split best-first
 // by bisection, a few times at most, which settles most curved elements of real meshes.
-// In 3D the stage also pairs J with an upper bound of the norms' product at each
+// In 3D and planar 2D the stage also pairs J with an upper bound of the norms' product at each
 // coefficient (paired_bound in the .cpp: |v| <= v . d + Q with d the mean direction of the
 // column's control points and Q of the order of their spread squared), whose gap shrinks
 // quadratically: it settles all 1,290 valid curved pyramids of warped_pyramid_o2 within 8
@@ -31,7 +31,7 @@
 // column's control points, so that J and the denominator are paired at the same point; it
 // settles all invalid elements of warped_hexahedron_o2 and warped_prism_o2 and 540 of the
 // 660 of warped_tetrahedron_o3 within 8 splits (single bisections, as the full bounds);
-// used for every 3D family (scaled_jacobian.cpp).
+// used for every 3D family and for planar 2D elements (scaled_jacobian.cpp).
 //
 // Errors: every coefficient carries an a priori bound (its input's, plus the bisection's
 // rounding_relative() * max|parent| + rounding_absolute() per split); a frame column is a
@@ -63,17 +63,18 @@ struct QuotientInput {
 };
 
 /// Certified bounds of sj(E) on an element where J > 0 is proven, refined best-first until
-/// upper - lower <= tol: in 3D with paired_bound (scaled_jacobian_quotient.cpp) by at most
-/// max_paired_splits splits, otherwise by at most max_splits. lower = -inf when the root's
+/// upper - lower <= tol: in 3D and planar 2D with paired_bound (scaled_jacobian_quotient.cpp)
+/// by at most max_paired_splits splits, otherwise (lines) by at most max_splits. lower = -inf when the root's
 /// least J coefficient is not positive (then nothing is refined); subdivisions counts the
 /// splits; tolerance_met says whether the gap closed.
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
                               int max_splits, int max_paired_splits);
 
-/// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D, with
+/// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D or
+/// planar 2D, with
 /// the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's signs: refined by
 /// at most max_splits best-first splits. Nothing (lower = -inf, upper = 0) where J does not
-/// lie in the space of the product of the three columns (none of the 3D types).
+/// lie in the space of the product of the columns (none of the 2D and 3D types).
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
                                      int max_splits);
 

@@ -86,8 +86,8 @@ const ScaledJacobianSpace& scaled_jacobian_space(const ElementType& type);
 QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<const double> nodes, bool planar,
                                              double tol, int max_splits);
 
-/// The signed first stage on its own (tests): bounds of sj(E) of a 3D element where J <= 0
-/// was found at a point (the caller's claim: upper starts at 0), from J's coefficients with
+/// The signed first stage on its own (tests): bounds of sj(E) of a 3D element, or a 2D one
+/// in a plane z = const, where J <= 0 was found at a point (the caller's claim: upper starts at 0), from J's coefficients with
 /// their signs and the columns (scaled_jacobian_quotient.hpp), refined by at most max_splits
 /// splits.
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
@@ -102,8 +102,8 @@ QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<co
 void scaled_jacobian_use_straight_path(bool on) noexcept;
 
 /// Tests only: switch off (on by default), in the calling thread, the paired bound of the
-/// first stage of valid 3D elements (scaled_jacobian_quotient.cpp, paired_bound): the stage
-/// then bounds J's least coefficient over the largest norms alone, as in 2D.
+/// first stage of valid elements (3D, planar 2D; scaled_jacobian_quotient.cpp,
+/// paired_bound): the stage then bounds J's least coefficient over the largest norms alone.
 void scaled_jacobian_use_paired_stage(bool on) noexcept;
 
 /// scaled_jacobian_bounds with the element's validity already settled by the Jacobian

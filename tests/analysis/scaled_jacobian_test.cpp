@@ -559,6 +559,7 @@ TEST(ScaledJacobian, FirstStageBoundsEncloseSampledAndFullBounds) {
 // refines (those whose first gap is within twice the tolerance) in 16 splits.
 TEST(ScaledJacobian, FirstStageRefinedEnclosesAndConverges) {
   std::mt19937 rng(77);
+  scaled_jacobian_use_paired_stage(false);  // this bound's own refinement (the paired one: below)
   std::size_t elements = 0, refined = 0, met = 0;
   for (const ElementType& t : element_types()) {
     if (!scaled_jacobian_supported(t) || t.order > 3) continue;
@@ -582,6 +583,7 @@ TEST(ScaledJacobian, FirstStageRefinedEnclosesAndConverges) {
       }
     }
   }
+  scaled_jacobian_use_paired_stage(true);
   EXPECT_GT(elements, 500u);
   EXPECT_GT(refined, 30u);
   EXPECT_GT(met, refined * 9 / 10);
@@ -598,13 +600,14 @@ TEST(ScaledJacobian, PairedStageEnclosesSampledMinimumOnCurvedValidElements) {
   std::mt19937 rng(9090);
   std::size_t elements = 0, met = 0, unpaired_met = 0;
   for (const ElementType& t : element_types()) {
-    if (!scaled_jacobian_supported(t) || t.dim != 3 || t.order > 3 || t.order < 2) continue;
+    if (!scaled_jacobian_supported(t) || t.dim < 2 || t.order > 3 || t.order < 2) continue;
     SCOPED_TRACE(std::string(t.name));
-    const auto pts = test::dense_points(t.family, 6, 40, rng);
+    const bool planar = t.dim == 2;
+    const auto pts = test::dense_points(t.family, t.dim == 3 ? 6 : 12, 40, rng);
     for (int e = 0; e < 24; ++e) {
       const std::vector<double> x = test::smooth_random_element(t, 0.02 + 0.02 * (e % 4), rng);
       if (!(sampled_min(t, x, pts) > 0)) continue;
-      const QualityBounds q = scaled_jacobian_quotient_stage(t, x, /*planar=*/false, 1e-2, 8);
+      const QualityBounds q = scaled_jacobian_quotient_stage(t, x, planar, 1e-2, 8);
       if (!std::isfinite(q.lower)) continue;  // J's least coefficient not positive
       expect_encloses(t, x, pts, q, e);
       EXPECT_LE(q.subdivisions, 8);
@@ -613,10 +616,10 @@ TEST(ScaledJacobian, PairedStageEnclosesSampledMinimumOnCurvedValidElements) {
         EXPECT_LE(q.upper - q.lower, 1e-2);
         ++met;
       }
-      const QualityBounds root = scaled_jacobian_quotient_stage(t, x, false, 1e-2, 0);
+      const QualityBounds root = scaled_jacobian_quotient_stage(t, x, planar, 1e-2, 0);
       scaled_jacobian_use_paired_stage(false);
-      const QualityBounds unpaired_root = scaled_jacobian_quotient_stage(t, x, false, 1e-2, 0);
-      if (scaled_jacobian_quotient_stage(t, x, false, 1e-2, 8).tolerance_met) ++unpaired_met;
+      const QualityBounds unpaired_root = scaled_jacobian_quotient_stage(t, x, planar, 1e-2, 0);
+      if (scaled_jacobian_quotient_stage(t, x, planar, 1e-2, 8).tolerance_met) ++unpaired_met;
       scaled_jacobian_use_paired_stage(true);
       EXPECT_GE(root.lower, unpaired_root.lower) << "element " << e;
     }
@@ -636,9 +639,9 @@ TEST(ScaledJacobian, SignedStageEnclosesSampledMinimumOnInvertedElements) {
   std::mt19937 rng(4242);
   std::size_t inverted = 0, met = 0;
   for (const ElementType& t : element_types()) {
-    if (!scaled_jacobian_supported(t) || t.dim != 3 || t.order > 3) continue;
+    if (!scaled_jacobian_supported(t) || t.dim < 2 || t.order > 3) continue;
     SCOPED_TRACE(std::string(t.name));
-    const auto pts = test::dense_points(t.family, 6, 40, rng);
+    const auto pts = test::dense_points(t.family, t.dim == 3 ? 6 : 12, 40, rng);
     for (int e = 0; e < 40; ++e) {
       const std::vector<double> x = test::smooth_random_element(t, 0.3 + 0.1 * (e % 4), rng);
       const double sampled = sampled_min(t, x, pts);
