@@ -18,6 +18,8 @@
 #include <cstddef>
 #include <limits>
 
+#include "analysis/outward_rounding.hpp"
+
 #if defined(__AVX512F__)
 #include <immintrin.h>
 #endif
@@ -81,6 +83,16 @@ RatioScan scan_ratios(const double* num, double a, const double* den, double b, 
     if (better(q, out.extreme)) out.extreme = q;
   }
   return out;
+}
+
+/// Below the exact quotient (num_i + a) / (den_i + b) whose computed value is q (an
+/// extreme of scan_ratios, den_i + b > 0 exactly): a difference of doubles keeps its sign,
+/// and the sum, the difference and the quotient round once each (relative u; an
+/// underflowing quotient loses at most denorm_min), so q moved by 4u toward -inf, less
+/// denorm_min, is below it. @pre q != 0 and finite
+inline double quotient_below(double q) {
+  constexpr double u = 0x1p-53;
+  return next_down(next_down(q * (q < 0 ? 1 + 4 * u : 1 - 4 * u)) - std::numeric_limits<double>::denorm_min());
 }
 
 }  // namespace quadval

@@ -139,7 +139,7 @@ class Bounder {
           frame_lower[t] = 0;
         } else {
           double r = scan.extreme;
-          r = r > 0 ? down(down(r * (1 - 4 * kUnit)) - std::numeric_limits<double>::denorm_min()) : 0;
+          r = r > 0 ? quotient_below(r) : 0;
           frame_lower[t] = down(space_.s_lo() * down(sqrt_rn(std::max(0.0, r))));
         }
         out = std::min(out, frame_lower[t]);

@@ -356,7 +356,7 @@ class Quotient {
         const RatioScan scan = scan_ratios<true>(leaf, -err[0], ws_.product.data(), -el, -el, sj);
         if (scan.least_den > 0) {
           const double least = std::min(scan.extreme, 0.0);
-          const double bound = least < 0 ? down(down(least * (1 + 4 * kUnit)) - std::numeric_limits<double>::denorm_min()) : 0.0;
+          const double bound = least < 0 ? quotient_below(least) : 0.0;
           frame_lower = std::max(frame_lower, down(s_hi * bound));
         }
       }
@@ -409,8 +409,7 @@ class Quotient {
         const RatioScan scan = scan_ratios<true>(leaf, -err[0], ws_.product.data(), el, el, sj);
         const double least = scan.extreme;
         if (scan.least_den > 0 && least > 0 && least < kInf)
-          frame_lower = std::max(frame_lower, down(s_lo * down(down(least * (1 - 4 * kUnit)) -
-                                                               std::numeric_limits<double>::denorm_min())));
+          frame_lower = std::max(frame_lower, down(s_lo * quotient_below(least)));
       }
       lower = std::min(lower, frame_lower);
       // Upper bounds at the leaf's corners: s J / prod |v_kj| with J at most J + e and the

@@ -148,15 +148,11 @@ std::optional<QualityBounds> trilinear_hex_sj_bounds(std::span<const double> x, 
                            (m1 + e1s) * (m2 + e2s) * e3s + rounding_gamma(40) * m1 * m2 * m3);
   if (!std::isfinite(e_n) || !std::isfinite(e_d)) return std::nullopt;  // overflow
 
-  // The relaxation: sj^2 >= min_i (N_i - e_n) / (D_i + e_d), every D_i - e_d > 0. Without
-  // directed roundings (ratio_scan.hpp): a difference of doubles keeps its sign, and the
-  // sum, the difference and the quotient round once each, so (1 - 4u) times the computed
-  // minimum, less denorm_min, is below the exact one.
+  // The relaxation: sj^2 >= min_i (N_i - e_n) / (D_i + e_d), every D_i - e_d > 0, scanned
+  // without directed roundings (ratio_scan.hpp, quotient_below).
   const RatioScan scan = scan_ratios<true>(&n[0][0][0], -e_n, &d[0][0][0], e_d, -e_d, 125);
   if (!(scan.least_den > 0)) return std::nullopt;
-  const double r_lo = scan.extreme > 0
-                          ? down(down(scan.extreme * (1 - 4 * kUnit)) - std::numeric_limits<double>::denorm_min())
-                          : 0.0;
+  const double r_lo = scan.extreme > 0 ? quotient_below(scan.extreme) : 0.0;
   QualityBounds out;
   out.lower = r_lo > 0 ? down(sqrt_rn(r_lo)) : 0.0;
   // Upper: sj at the corners, where the columns are the three edges there.
