@@ -171,10 +171,9 @@ void BM_CheckCurvedTetP2(benchmark::State& state) {
 }
 BENCHMARK(BM_CheckCurvedTetP2)->Args({55, 1})->Args({55, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// First-order tetrahedra (6 n^3, range 0) on one thread: validity (range 1 = 0), mu (1) or
-// the scaled Jacobian (2), for the cost of each measure over the validity check.
-void BM_CheckLinearTetQuality(benchmark::State& state) {
-  static const Mesh mesh = curved_tets(static_cast<int>(state.range(0)), 1, 0.15);
+// One thread: validity (range 1 = 0), mu (1) or the scaled Jacobian (2), for the cost of
+// each measure over the validity check.
+void run_quality(benchmark::State& state, const Mesh& mesh) {
   CheckOptions o;
   o.threads = 1;
   o.measure = state.range(1) == 0 ? CheckMeasure::validity : state.range(1) == 1 ? CheckMeasure::mu
@@ -183,8 +182,21 @@ void BM_CheckLinearTetQuality(benchmark::State& state) {
   state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
                                                     benchmark::Counter::kIsIterationInvariantRate);
 }
+
+// First-order tetrahedra, 6 n^3 (range 0).
+void BM_CheckLinearTetQuality(benchmark::State& state) {
+  static const Mesh mesh = curved_tets(static_cast<int>(state.range(0)), 1, 0.15);
+  run_quality(state, mesh);
+}
 // 6 * 40^3 = 384,000 tetrahedra
 BENCHMARK(BM_CheckLinearTetQuality)->ArgsProduct({{40}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
+
+// First-order hexahedra, n^3 (range 0), vertices moved by up to 0.2 of the spacing.
+void BM_CheckLinearHexQuality(benchmark::State& state) {
+  static const Mesh mesh = linear_hexes(static_cast<int>(state.range(0)), 0.2);
+  run_quality(state, mesh);
+}
+BENCHMARK(BM_CheckLinearHexQuality)->ArgsProduct({{40}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 
 // Separate random elements of one Gmsh type (range 2), range 0 of them.
 void BM_CheckCurvedType(benchmark::State& state) {

@@ -22,6 +22,7 @@
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/straight_tet_mu.hpp"
+#include "analysis/trilinear_hex_mu.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/error.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -247,6 +248,11 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   if (validity == Validity::valid && mu_constant_path_enabled()) {
     if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol, known)) return *straight;
     if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
+    if (type.family == ElementFamily::hexahedron && type.num_nodes == 8) {
+      const TrilinearHexRatio hex = trilinear_hex_ratio(nodes);
+      if (hex.ok)
+        if (const auto mu = mu_from_ratio(hex.lower, hex.upper, options.abs_tol)) return *mu;
+    }
   }
   const double err0 = element_w(space, nodes, pool.data());
   // Constant W (straight-sided simplices, parallelograms, parallelepipeds): W's control

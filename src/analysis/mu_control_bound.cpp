@@ -8,14 +8,13 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 
 #include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/sqrt_rn.hpp"
+#include "analysis/symmetric3_lanes.hpp"
 #include "quadval/bezier_basis.hpp"
 
 namespace quadval {
@@ -158,53 +157,14 @@ bool ratio_at_least3(const double* m, double err, double r) {
 
 namespace {
 
-// ratio_at_least3 and positive_definite3 on 8 matrices at once (lane l: entries m[i][l]),
-// every lane computed with the same operations, in the same order, as the scalar
-// functions (bit-identical decisions); true lanes set in the returned mask.
 using L8 = Lanes<8>;
-typedef std::int64_t I8 __attribute__((vector_size(64)));
+using lanes3::down;
+using lanes3::up;
 
-L8 next_up8(L8 x) {  // next_up (outward_rounding.hpp) lane by lane
-  constexpr std::int64_t kMagnitude = 0x7fffffffffffffff, kInfBits = 0x7ff0000000000000;
-  const I8 b = std::bit_cast<I8>(x);
-  const I8 mag = b & kMagnitude;
-  I8 r = b < 0 ? b - 1 : b + 1;
-  r = mag == 0 ? I8{} + 1 : r;
-  r = (mag > kInfBits) | (b == kInfBits) ? b : r;
-  return std::bit_cast<L8>(r);
-}
-L8 next_down8(L8 x) { return -next_up8(-x); }
-
-I8 positive_definite3_lanes(const L8* a) {
-  static const double g = rounding_gamma(8);
-  const L8 p01 = a[0] * a[1], s01 = a[3] * a[3];
-  const L8 c0 = a[1] * a[2] - a[5] * a[5];
-  const L8 c1 = a[3] * a[2] - a[5] * a[4];
-  const L8 c2 = a[3] * a[5] - a[1] * a[4];
-  const L8 det = a[0] * c0 - a[3] * c1 + a[4] * c2;
-  const L8 mag = vabs(a[0]) * (vabs(a[1] * a[2]) + a[5] * a[5]) + vabs(a[3]) * (vabs(a[3] * a[2]) + vabs(a[5] * a[4])) +
-                 vabs(a[4]) * (vabs(a[3] * a[5]) + vabs(a[1] * a[4]));
-  return (a[0] > 0) & (p01 - s01 > g * (vabs(p01) + s01) * (1 + g)) & (det > g * mag * (1 + g));
-}
-
+// ratio_at_least3 on 8 matrices at once (lane l: entries m[i][l]), bit-identical decisions
+// (symmetric3_lanes.hpp); true lanes set in the returned mask.
 unsigned ratio_at_least3_lanes(const L8* m, double err, double r) {
-  constexpr double u = 0x1p-53;
-  const L8 c = (m[0] + m[1] + m[2]) / 3;
-  const L8 shift = 4 * u * (vabs(m[0]) + vabs(m[1]) + vabs(m[2]));
-  const L8 d0 = m[0] - c, d1 = m[1] - c, d2 = m[2] - c;
-  const L8 sq = d0 * d0 + d1 * d1 + d2 * d2 + 2 * (m[3] * m[3] + m[4] * m[4] + m[5] * m[5]);
-  const I8 finite = vabs(sq) <= std::numeric_limits<double>::max();
-  L8 root = next_up8(sq * (2.0 / 3.0) * (1 + 16 * u));
-  for (int l = 0; l < 8; ++l) root[l] = std::sqrt(root[l]);  // vsqrtpd: exact rounding, as std::sqrt
-  const L8 spread = next_up8(root);
-  const double e3 = next_up(3 * err * (1 + 1e-15));
-  const L8 t = next_up8(next_up8(next_up8(c + shift) + spread) + e3);
-  const L8 sa = next_up8(next_up8(r * t) + e3);
-  const L8 a[6] = {next_down8(m[0] - sa), next_down8(m[1] - sa), next_down8(m[2] - sa), m[3], m[4], m[5]};
-  const I8 ok = finite & positive_definite3_lanes(a);
-  unsigned mask = 0;
-  for (int l = 0; l < 8; ++l) mask |= ok[l] != 0 ? 1u << l : 0u;
-  return mask;
+  return lanes3::mask_bits<8>(lanes3::ratio_at_least<8>(m, err, r));
 }
 
 // symmetric_eigen_enclosure<2>(m, err).ratio_lower() of 8 matrices at once (lane l:
@@ -213,22 +173,22 @@ unsigned ratio_at_least3_lanes(const L8* m, double err, double r) {
 L8 enclosure_ratio_lower2_lanes(const L8* m, double err) {
   const L8 zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
   const L8 rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
-  const L8 s_hi = next_up8(vabs(s) + rq), s_lo = vmax(zero, next_down8(vabs(s) - rq));
-  const L8 t_hi = next_up8(vabs(t) + err), t_lo = vmax(zero, next_down8(vabs(t) - err));
-  L8 d_hi = next_up8(next_up8(s_hi * s_hi) + next_up8(t_hi * t_hi));
-  L8 d_lo = vmax(zero, next_down8(next_down8(s_lo * s_lo) + next_down8(t_lo * t_lo)));
+  const L8 s_hi = up<8>(vabs(s) + rq), s_lo = vmax(zero, down<8>(vabs(s) - rq));
+  const L8 t_hi = up<8>(vabs(t) + err), t_lo = vmax(zero, down<8>(vabs(t) - err));
+  L8 d_hi = up<8>(up<8>(s_hi * s_hi) + up<8>(t_hi * t_hi));
+  L8 d_lo = vmax(zero, down<8>(down<8>(s_lo * s_lo) + down<8>(t_lo * t_lo)));
   for (int l = 0; l < 8; ++l) {  // vsqrtpd: exact rounding, as std::sqrt
     d_hi[l] = std::sqrt(d_hi[l]);
     d_lo[l] = std::sqrt(d_lo[l]);
   }
-  d_hi = next_up8(d_hi);
-  d_lo = vmax(zero, next_down8(d_lo));
-  const L8 q_lo = next_down8(q - rq), q_hi = next_up8(q + rq);
-  const L8 min_lo = next_down8(q_lo - d_hi), max_hi = next_up8(q_hi + d_hi);
+  d_hi = up<8>(d_hi);
+  d_lo = vmax(zero, down<8>(d_lo));
+  const L8 q_lo = down<8>(q - rq), q_hi = up<8>(q + rq);
+  const L8 min_lo = down<8>(q_lo - d_hi), max_hi = up<8>(q_hi + d_hi);
   constexpr double kMax = std::numeric_limits<double>::max();
   // An enclosure that is unknown (a non-finite step) or not positive: ratio 0.
   const auto known = (vabs(q_lo) <= kMax) & (vabs(q_hi) <= kMax) & (vabs(d_hi) <= kMax) & (min_lo > 0) & (max_hi < kInf);
-  const L8 ratio = next_down8(min_lo / max_hi);
+  const L8 ratio = down<8>(min_lo / max_hi);
   return known ? vmin(vmax(ratio, zero), L8{} + 1) : zero;
 }
 

@@ -1,0 +1,169 @@
+// R's bounds of a first-order hexahedron from its control matrices, in lanes (see the
+// header for the method and its rounding).
+#include "analysis/trilinear_hex_mu.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+
+#include "analysis/symmetric3_lanes.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+using namespace lanes3;
+using L8 = Lanes<8>;
+
+constexpr double kUnit = 0x1p-53;
+constexpr int kPoints = 27;
+constexpr int kSlots = 32;  // 4 blocks of 8 lanes; the spare lanes repeat point 0
+
+// Gmsh's vertex at Bernstein index (i, j, k), i + 2 j + 4 k.
+constexpr int kNode[8] = {0, 1, 3, 2, 4, 5, 7, 6};
+
+// The control points (d0, d1, d2) of degree 2, as d0 + 3 d1 + 9 d2, by slot: the 8
+// corners first (slot q: corner q = (i, j, k) -> (2i, 2j, 2k)), so that lane block 0 serves
+// the upper bound too, then the others in order; the spare slots repeat slot 0. Per entry
+// of M, the slot's source among the values diagonal_entry and cross_entry compute.
+constexpr int kCross[3][2] = {{0, 1}, {0, 2}, {1, 2}};  // entries m01, m02, m12
+
+struct Layout {
+  std::array<int, kSlots> point{};
+  std::array<std::array<std::uint8_t, kSlots>, 3> diagonal_source{};  // b + 3 c (along x + 1, x + 2)
+  std::array<std::array<std::uint8_t, kSlots>, 3> cross_source{};     // 9 a + 3 b + c (along x, y, z)
+};
+
+Layout make_layout() {
+  Layout l;
+  const auto is_corner = [](int p) { return p % 3 != 1 && (p / 3) % 3 != 1 && p / 9 != 1; };
+  int s = 0;
+  for (int q = 0; q < 8; ++q) l.point[static_cast<std::size_t>(s++)] = 2 * (q & 1) + 6 * ((q >> 1) & 1) + 18 * (q >> 2);
+  for (int p = 0; p < kPoints; ++p)
+    if (!is_corner(p)) l.point[static_cast<std::size_t>(s++)] = p;
+  QV_ASSERT(s == kPoints, s << " control points");
+  for (; s < kSlots; ++s) l.point[static_cast<std::size_t>(s)] = l.point[0];
+  for (int t = 0; t < kSlots; ++t) {
+    const int p = l.point[static_cast<std::size_t>(t)];
+    const int d[3] = {p % 3, (p / 3) % 3, p / 9};
+    for (int x = 0; x < 3; ++x) {
+      l.diagonal_source[static_cast<std::size_t>(x)][static_cast<std::size_t>(t)] =
+          static_cast<std::uint8_t>(d[(x + 1) % 3] + 3 * d[(x + 2) % 3]);
+      const int y = kCross[x][1], xx = kCross[x][0], z = 3 - xx - y;
+      l.cross_source[static_cast<std::size_t>(x)][static_cast<std::size_t>(t)] =
+          static_cast<std::uint8_t>(9 * d[xx] + 3 * d[y] + d[z]);
+    }
+  }
+  return l;
+}
+
+const Layout& layout() {
+  static const Layout l = make_layout();
+  return l;
+}
+
+double dot(const double* f, const double* g) { return f[0] * g[0] + f[1] * g[1] + f[2] * g[2]; }
+
+// The control values of M_xx = |w_x|^2, by slot. w_x is constant along x: with u, v the
+// other two directions, its control values F[iu][iv]; M_xx(b, c) is the mean of
+// F[u1][v1] . F[u2][v2] over u1 + u2 = b, v1 + v2 = c, the same at every index along x.
+void diagonal_entry(const double (*w)[3], int x, const Layout& lay, double* out) {
+  const int u = (x + 1) % 3, v = (x + 2) % 3;
+  const double* f[2][2];
+  for (int iu = 0; iu < 2; ++iu)
+    for (int iv = 0; iv < 2; ++iv) f[iu][iv] = w[(iu << u) | (iv << v)];
+  double h[3][3] = {};
+  for (int u1 = 0; u1 < 2; ++u1)
+    for (int v1 = 0; v1 < 2; ++v1)
+      for (int u2 = 0; u2 < 2; ++u2)
+        for (int v2 = 0; v2 < 2; ++v2) h[u1 + u2][v1 + v2] += dot(f[u1][v1], f[u2][v2]);
+  double mean[9];
+  for (int b = 0; b < 3; ++b)
+    for (int c = 0; c < 3; ++c) mean[b + 3 * c] = h[b][c] * ((b == 1 ? 0.5 : 1.0) * (c == 1 ? 0.5 : 1.0));
+  const auto& source = lay.diagonal_source[static_cast<std::size_t>(x)];
+  for (int t = 0; t < kSlots; ++t) out[t] = mean[source[static_cast<std::size_t>(t)]];
+}
+
+// The control values of M_xy = w_x . w_y (entry kCross[e]), z the third direction, by
+// slot: w_x varies along y and z (F[j][k]), w_y along x and z (G[i][k]); their product
+// H[i][j][c] (degree 1, 1, 2 along x, y, z) is the mean of F[j][k1] . G[i][k2] over
+// k1 + k2 = c, then raised to degree 2 along x and y (the value at index 1 the mean of
+// those at 0 and 1).
+void cross_entry(const double (*w)[8][3], int e, const Layout& lay, double* out) {
+  const int x = kCross[e][0], y = kCross[e][1], z = 3 - x - y;
+  double h[2][2][3] = {};
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 2; ++j)
+      for (int k1 = 0; k1 < 2; ++k1)
+        for (int k2 = 0; k2 < 2; ++k2) h[i][j][k1 + k2] += dot(w[x][(j << y) | (k1 << z)], w[y][(i << x) | (k2 << z)]);
+  constexpr int kFrom[3][2] = {{0, 0}, {0, 1}, {1, 1}};  // degree-1 indices averaged at 0, 1, 2
+  double raised[27];
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b)
+      for (int c = 0; c < 3; ++c)
+        raised[9 * a + 3 * b + c] = (h[kFrom[a][0]][kFrom[b][0]][c] + h[kFrom[a][1]][kFrom[b][0]][c] +
+                                     h[kFrom[a][0]][kFrom[b][1]][c] + h[kFrom[a][1]][kFrom[b][1]][c]) *
+                                    (c == 1 ? 0.125 : 0.25);
+  const auto& source = lay.cross_source[static_cast<std::size_t>(e)];
+  for (int t = 0; t < kSlots; ++t) out[t] = raised[source[static_cast<std::size_t>(t)]];
+}
+
+}  // namespace
+
+TrilinearHexRatio trilinear_hex_ratio(std::span<const double> x) {
+  QV_ASSERT(x.size() == 24, x.size() << " coordinates for a first-order hexahedron");
+  const Layout& lay = layout();
+  // Column c's control value at vertex q: the edge along direction c through q.
+  double w[3][8][3];
+  double a = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int q = 0; q < 8; ++q) {
+      const int from = q & ~(1 << c), to = q | (1 << c);
+      for (int k = 0; k < 3; ++k) {
+        const double e = x[static_cast<std::size_t>(3 * kNode[to] + k)] - x[static_cast<std::size_t>(3 * kNode[from] + k)];
+        w[c][q][k] = e;
+        a = std::max(a, std::abs(e));
+      }
+    }
+  const double delta = next_up(2 * kUnit * a * kSlack);
+  const double err = next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
+  TrilinearHexRatio out;
+  if (!(err < kMax) || !(a > 0)) return out;
+  // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
+  alignas(64) double m[6][kSlots];
+  for (int x = 0; x < 3; ++x) diagonal_entry(w[x], x, lay, m[x]);
+  for (int e = 0; e < 3; ++e) cross_entry(w, e, lay, m[3 + e]);
+  // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp). The
+  // corners (block 0) are enclosed first; a later block is enclosed only where the cheaper
+  // test does not certify all its lanes at least their least ratio, which then stays the
+  // bound (hex_box_30: most blocks of a good element).
+  L8 corner_m[6];
+  for (int e = 0; e < 6; ++e) corner_m[e] = load_lanes<8>(m[e]);
+  const ExtremeEigen<8> corners = extreme_eigen<8>(corner_m, broadcast_lanes<8>(err));
+  const Mask<8> corner_ok = corners.ok & (corners.lo > 0);
+  if (mask_bits<8>(corner_ok) != 0xffu) return out;
+  double lower = fold_min(down<8>(corners.lo / corners.hi), 1.0);
+  for (int b = 1; b < kSlots / 8; ++b) {
+    L8 mb[6];
+    for (int e = 0; e < 6; ++e) mb[e] = load_lanes<8>(&m[e][8 * b]);
+    if (lower > 0 && lower < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, lower)) == 0xffu) continue;
+    const ExtremeEigen<8> eig = extreme_eigen<8>(mb, broadcast_lanes<8>(err));
+    const Mask<8> ok = eig.ok & (eig.lo > 0);
+    if (mask_bits<8>(ok) != 0xffu) return out;
+    lower = fold_min(down<8>(eig.lo / eig.hi), lower);
+  }
+  // Upper: Rayleigh quotients of W at the corners (block 0: slot q is corner q).
+  L8 wc[3][3];
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < 3; ++k)
+      for (int q = 0; q < 8; ++q) wc[c][k][q] = w[c][q][k];
+  Mask<8> vectors_ok;
+  const L8 upper = ratio_upper<8>(wc, corner_m, corners.lo, corners.hi, broadcast_lanes<8>(delta), vectors_ok);
+  out.lower = std::clamp(lower, 0.0, 1.0);
+  out.upper = std::clamp(fold_min(upper, 1.0), 0.0, 1.0);
+  out.ok = out.lower <= out.upper;
+  return out;
+}
+
+}  // namespace quadval

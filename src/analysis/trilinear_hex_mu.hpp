@@ -1,0 +1,38 @@
+#pragma once
+// Bounds of R = lambda_min / lambda_max of W^T W (mu = sqrt R, Paper V) for a valid
+// first-order hexahedron, without subdivision: the control-matrix bound of
+// mu_control_bound.hpp on its 27 control matrices (lower) and Rayleigh quotients at its 8
+// corners (upper), every matrix in SIMD lanes (symmetric3_lanes.hpp). Most first-order
+// hexahedra of a mesh are settled by these at the root; the general path (mu_bounds.cpp)
+// computed the same two bounds with a product table, one eigen solve per corner and a test
+// per control matrix. Internal to src/analysis.
+//
+// The map. With Gmsh's node order and Bernstein indices (i, j, k) in {0, 1}^3 at the
+// vertices, column x of J is a trilinear polynomial constant along its own direction,
+// e.g. column 0 has control values x_(1,j,k) - x_(0,j,k) (twice J's on [-1, 1]^3; R does not
+// depend on W's scale, and the ideal cube's J_i is a multiple of I). So each entry
+// M_xy = w_x . w_y of the metric has degree 2 per direction, its control value at
+// (a, b, c) in {0, 1, 2}^3 the mean of the products w_x(q) . w_y(q') over the vertex
+// pairs with q + q' = (a, b, c) (Paper V Prop. 4). At the 8 corners, (2i, 2j, 2k), that
+// value is the metric itself.
+//
+// Rounding. Each edge coordinate is one difference, within 2u A of the exact one (A the
+// largest edge coordinate); a control value is a mean of at most 8 sums of 3 products,
+// within gamma_10 of the sum of its terms' magnitudes, at most 3 A^2, plus the propagated
+// edge errors 3 (2 A + delta) delta. One bound err for all entries; every final bound is
+// stepped outward (symmetric3_lanes.hpp).
+#include <span>
+
+namespace quadval {
+
+struct TrilinearHexRatio {
+  double lower = 0, upper = 1;  ///< lower <= min R <= upper over the element, where ok
+  bool ok = false;              ///< false: a certification failed; use the general path
+};
+
+/// R's bounds for the hexahedron with these 8 vertices (x, y, z each, Gmsh order), J > 0
+/// proven on it by the caller. Not ok where a control matrix is not certified positive
+/// definite or an eigenvalue step fails (a nearly degenerate element).
+TrilinearHexRatio trilinear_hex_ratio(std::span<const double> x);
+
+}  // namespace quadval
