@@ -1,0 +1,47 @@
+#pragma once
+// Bounds of R = lambda_min / lambda_max of W^T W (mu = sqrt R, Paper V) for a valid
+// first-order pyramid, without subdivision: the control-matrix bound of
+// mu_control_bound.hpp on its 9 control matrices (lower) and Rayleigh quotients at its 4
+// base corners (upper), in SIMD lanes (symmetric3_lanes.hpp). Internal to src/analysis.
+//
+// The map. Gmsh's pyramid (base [-1, 1]^2, apex (0, 0, 1)) in cube coordinates
+// xi = u (1 - w), eta = v (1 - w), zeta = w is x = (1 - w) f(u, v) + w x_4, with f the
+// bilinear map of the base. Its columns in (xi, eta, zeta) do not depend on w:
+//   J_1 = f_u(v),  J_2 = f_v(u),  J_3 = x_4 - f + u f_u + v f_v = x_4 - a + d u v,
+// with f = a + b u + c v + d u v; so W = J_p J_i^-1 = J_p diag(1, 1, 1/sqrt 2) (J_i as
+// mu_space.cpp scales it) is a bilinear function of (u, v) alone, and min R over the
+// pyramid is min R over the square. Twice those columns have the Bernstein control values
+// (vertex (i, j) of the square, base node n(i, j) = 0, 1, 3, 2 for (0,0), (1,0), (0,1), (1,1)):
+//   2 J_1: x_1 - x_0 (j = 0), x_2 - x_3 (j = 1);   2 J_2: x_3 - x_0 (i = 0), x_2 - x_1 (i = 1);
+//   2 J_3: (x_4 - x_1) + (x_4 - x_3) where u v = 1, (x_4 - x_0) + (x_4 - x_2) where u v = -1.
+// M = W^T W has degree 2 in each of u and v: its control value at (a, b) in {0, 1, 2}^2 is
+// the mean of W(q) . W(q') over the vertex pairs with q + q' = (a, b) (Paper V Prop. 4);
+// at the corners it is the metric itself.
+//
+// Rounding. A difference rounds once (relative u); the third column adds two differences
+// and is multiplied by a rounded 1/sqrt 2: within 8u D of the exact W, D the largest
+// difference coordinate. The control values are means of at most 4 sums of 3 products,
+// within gamma_10 of their terms' magnitudes, at most 3 B^2 (B >= every |W| entry), plus
+// the propagated errors 3 (2 B + delta) delta.
+//
+// A base that is a parallelogram makes W constant (d = 0 above): then the closed form of
+// straight-sided tetrahedra (straight_tet_mu.hpp) bounds R, the columns' spread over the
+// vertices counted in their margins, as mu_bounds' constant-W path did.
+#include <array>
+#include <span>
+
+namespace quadval {
+
+struct LinearPyramidRatio {
+  double lower = 0, upper = 1;  ///< lower <= min R <= upper over the element, where ok
+  bool ok = false;              ///< false: a certification failed; use the general path
+};
+
+/// R's bounds for the pyramid with these 5 nodes (x, y, z each, Gmsh order), J > 0 proven
+/// on it by the caller. Not ok where a control matrix is not certified positive definite
+/// or an eigenvalue step fails (a nearly degenerate element).
+/// @param jinv  the ideal pyramid's inverse Jacobian (MuSpace::ideal_inverse), for the
+///              closed form of a parallelogram base
+LinearPyramidRatio linear_pyramid_ratio(std::span<const double> x, const std::array<double, 9>& jinv);
+
+}  // namespace quadval
