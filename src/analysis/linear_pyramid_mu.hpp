@@ -15,33 +15,24 @@
 //   2 J_1: x_1 - x_0 (j = 0), x_2 - x_3 (j = 1);   2 J_2: x_3 - x_0 (i = 0), x_2 - x_1 (i = 1);
 //   2 J_3: (x_4 - x_1) + (x_4 - x_3) where u v = 1, (x_4 - x_0) + (x_4 - x_2) where u v = -1.
 // M = W^T W has degree 2 in each of u and v: its control value at (a, b) in {0, 1, 2}^2 is
-// the mean of W(q) . W(q') over the vertex pairs with q + q' = (a, b) (Paper V Prop. 4);
-// at the corners it is the metric itself.
+// the mean of W(q) . W(q') over the vertex pairs with q + q' = (a, b) (Paper V Prop. 4;
+// vertex_metric_ratio.hpp bounds R from those); at the corners it is the metric itself.
 //
-// Rounding. A difference rounds once (relative u); the third column adds two differences
-// and is multiplied by a rounded 1/sqrt 2: within 8u D of the exact W, D the largest
-// difference coordinate. The control values are means of at most 4 sums of 3 products,
-// within gamma_10 of their terms' magnitudes, at most 3 B^2 (B >= every |W| entry), plus
-// the propagated errors 3 (2 B + delta) delta.
-//
-// A base that is a parallelogram makes W constant (d = 0 above): then the closed form of
-// straight-sided tetrahedra (straight_tet_mu.hpp) bounds R, the columns' spread over the
-// vertices counted in their margins, as mu_bounds' constant-W path did.
+// Rounding. A difference rounds once (relative u); the third column adds two of them,
+// within 4u D (D the largest difference coordinate); columns_ratio (vertex_metric_ratio.hpp)
+// covers the product with J_i^-1. A parallelogram base (d = 0 above) makes W constant,
+// which columns_ratio bounds in closed form.
 #include <array>
 #include <span>
 
-namespace quadval {
+#include "analysis/vertex_metric_ratio.hpp"
 
-struct LinearPyramidRatio {
-  double lower = 0, upper = 1;  ///< lower <= min R <= upper over the element, where ok
-  bool ok = false;              ///< false: a certification failed; use the general path
-};
+namespace quadval {
 
 /// R's bounds for the pyramid with these 5 nodes (x, y, z each, Gmsh order), J > 0 proven
 /// on it by the caller. Not ok where a control matrix is not certified positive definite
 /// or an eigenvalue step fails (a nearly degenerate element).
-/// @param jinv  the ideal pyramid's inverse Jacobian (MuSpace::ideal_inverse), for the
-///              closed form of a parallelogram base
-LinearPyramidRatio linear_pyramid_ratio(std::span<const double> x, const std::array<double, 9>& jinv);
+/// @param jinv  the ideal pyramid's inverse Jacobian (MuSpace::ideal_inverse)
+CertifiedRatio linear_pyramid_ratio(std::span<const double> x, const std::array<double, 9>& jinv);
 
 }  // namespace quadval

@@ -14,6 +14,7 @@
 
 #include "analysis/bilinear_quad_quality.hpp"
 #include "analysis/lane_vector.hpp"
+#include "analysis/linear_prism_mu.hpp"
 #include "analysis/linear_pyramid_mu.hpp"
 #include "analysis/mu_constant.hpp"
 #include "analysis/mu_control_bound.hpp"
@@ -249,16 +250,22 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   if (validity == Validity::valid && mu_constant_path_enabled()) {
     if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol, known)) return *straight;
     if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
-    // First-order hexahedra and pyramids: their control matrices at the root, in lanes.
+    // First-order hexahedra, pyramids and prisms: their control matrices at the root, in
+    // lanes.
     if (type.family == ElementFamily::hexahedron && type.num_nodes == 8) {
-      const TrilinearHexRatio hex = trilinear_hex_ratio(nodes);
+      const CertifiedRatio hex = trilinear_hex_ratio(nodes);
       if (hex.ok)
         if (const auto mu = mu_from_ratio(hex.lower, hex.upper, options.abs_tol)) return *mu;
     }
     if (type.family == ElementFamily::pyramid && type.num_nodes == 5) {
-      const LinearPyramidRatio pyramid = linear_pyramid_ratio(nodes, space.ideal_inverse());
+      const CertifiedRatio pyramid = linear_pyramid_ratio(nodes, space.ideal_inverse());
       if (pyramid.ok)
         if (const auto mu = mu_from_ratio(pyramid.lower, pyramid.upper, options.abs_tol)) return *mu;
+    }
+    if (type.family == ElementFamily::prism && type.num_nodes == 6) {
+      const CertifiedRatio prism = linear_prism_ratio(nodes, space.ideal_inverse());
+      if (prism.ok)
+        if (const auto mu = mu_from_ratio(prism.lower, prism.upper, options.abs_tol)) return *mu;
     }
   }
   const double err0 = element_w(space, nodes, pool.data());

@@ -26,8 +26,10 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/mu_metric.cpp
   src/analysis/mu_constant.cpp
   src/analysis/straight_tet_mu.cpp
+  src/analysis/vertex_metric_ratio.cpp
   src/analysis/trilinear_hex_mu.cpp
   src/analysis/linear_pyramid_mu.cpp
+  src/analysis/linear_prism_mu.cpp
   src/analysis/mu_control_bound.cpp
   src/analysis/mu_bounds.cpp
   src/analysis/check_report.cpp

@@ -111,7 +111,7 @@ void cross_entry(const double (*w)[8][3], int e, const Layout& lay, double* out)
 
 }  // namespace
 
-TrilinearHexRatio trilinear_hex_ratio(std::span<const double> x) {
+CertifiedRatio trilinear_hex_ratio(std::span<const double> x) {
   QV_ASSERT(x.size() == 24, x.size() << " coordinates for a first-order hexahedron");
   const Layout& lay = layout();
   // Column c's control value at vertex q: the edge along direction c through q.
@@ -128,7 +128,7 @@ TrilinearHexRatio trilinear_hex_ratio(std::span<const double> x) {
     }
   const double delta = next_up(2 * kUnit * a * kSlack);
   const double err = next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
-  TrilinearHexRatio out;
+  CertifiedRatio out;
   if (!(err < kMax) || !(a > 0)) return out;
   // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
   alignas(64) double m[6][kSlots];

@@ -23,16 +23,13 @@
 // stepped outward (symmetric3_lanes.hpp).
 #include <span>
 
-namespace quadval {
+#include "analysis/vertex_metric_ratio.hpp"
 
-struct TrilinearHexRatio {
-  double lower = 0, upper = 1;  ///< lower <= min R <= upper over the element, where ok
-  bool ok = false;              ///< false: a certification failed; use the general path
-};
+namespace quadval {
 
 /// R's bounds for the hexahedron with these 8 vertices (x, y, z each, Gmsh order), J > 0
 /// proven on it by the caller. Not ok where a control matrix is not certified positive
 /// definite or an eigenvalue step fails (a nearly degenerate element).
-TrilinearHexRatio trilinear_hex_ratio(std::span<const double> x);
+CertifiedRatio trilinear_hex_ratio(std::span<const double> x);
 
 }  // namespace quadval

@@ -64,7 +64,7 @@ TEST(LinearPyramidMu, BoundsEncloseSampledAndCornerValues) {
     const auto x = random_pyramid(e, amplitude, rng);
     if (jacobian_bounds(t, x, bounds_options, workspace).validity != Validity::valid) continue;
     ++valid;
-    const LinearPyramidRatio r = linear_pyramid_ratio(x, jinv());
+    const CertifiedRatio r = linear_pyramid_ratio(x, jinv());
     if (!r.ok) continue;
     ++ok;
     ASSERT_LE(0.0, r.lower);
@@ -97,7 +97,7 @@ TEST(LinearPyramidMu, LowerBoundIsTheLeastControlMatrixRatio) {
   int interior = 0, general = 0;
   for (int e = 0; e < 600; ++e) {
     const auto x = random_pyramid(e, e % 2 == 0 ? 0.2 : 0.4, rng);
-    const LinearPyramidRatio r = linear_pyramid_ratio(x, jinv());
+    const CertifiedRatio r = linear_pyramid_ratio(x, jinv());
     if (!r.ok) continue;
     Eigen::Matrix3d g[3][3];
     for (int a = 0; a < 3; ++a)
@@ -142,7 +142,7 @@ TEST(LinearPyramidMu, ParallelogramBasesGetTheirConstantRatio) {
     BoundsOptions bo;
     BoundsWorkspace ws;
     if (jacobian_bounds(t, x, bo, ws).validity != Validity::valid) continue;
-    const LinearPyramidRatio r = linear_pyramid_ratio(x, jinv());
+    const CertifiedRatio r = linear_pyramid_ratio(x, jinv());
     ASSERT_TRUE(r.ok) << "element " << e;
     const double mu = test::pointwise_mu(basis, x, {0.3, -0.2, 0.4});
     EXPECT_LE(r.lower, mu * mu * (1 + 1e-12));

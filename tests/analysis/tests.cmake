@@ -8,6 +8,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/straight_tet_mu_test.cpp
   analysis/trilinear_hex_mu_test.cpp
   analysis/linear_pyramid_mu_test.cpp
+  analysis/linear_prism_mu_test.cpp
   analysis/mu_control_bound_test.cpp
   analysis/mu_high_order_test.cpp
   analysis/pyramid_quality_test.cpp

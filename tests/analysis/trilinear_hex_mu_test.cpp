@@ -56,7 +56,7 @@ TEST(TrilinearHexMu, BoundsEncloseSampledAndCornerValues) {
     const auto x = random_hexahedron(e, amplitude, rng);
     if (jacobian_bounds(t, x, bounds_options, workspace).validity != Validity::valid) continue;
     ++valid;
-    const TrilinearHexRatio r = trilinear_hex_ratio(x);
+    const CertifiedRatio r = trilinear_hex_ratio(x);
     if (!r.ok) continue;
     ++ok;
     ASSERT_LE(0.0, r.lower);
@@ -92,7 +92,7 @@ TEST(TrilinearHexMu, LowerBoundIsTheLeastControlMatrixRatio) {
   int interior = 0;
   for (int e = 0; e < 600; ++e) {
     const auto x = random_hexahedron(e, e % 2 == 0 ? 0.3 : 0.6, rng);
-    const TrilinearHexRatio r = trilinear_hex_ratio(x);
+    const CertifiedRatio r = trilinear_hex_ratio(x);
     if (!r.ok) continue;
     Eigen::Matrix3d g[3][3][3];
     for (int a = 0; a < 3; ++a)
@@ -146,7 +146,7 @@ TEST(TrilinearHexMu, ParallelepipedsGetTheirStretchRatio) {
                                   .toRotationMatrix();
     const Eigen::Vector3d d(s(rng), s(rng), s(rng));
     const auto x = test::affine_ideal_element(t, q * d.asDiagonal(), Eigen::Vector3d(u(rng), u(rng), 7 * u(rng)));
-    const TrilinearHexRatio r = trilinear_hex_ratio(x);
+    const CertifiedRatio r = trilinear_hex_ratio(x);
     ASSERT_TRUE(r.ok) << "element " << e;
     const double exact = std::pow(d.minCoeff() / d.maxCoeff(), 2);
     EXPECT_LE(r.lower, exact * (1 + 1e-14));

@@ -1,0 +1,132 @@
+// R's bounds from W's vertex values, in lanes (see the header).
+#include "analysis/vertex_metric_ratio.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "analysis/lane_vector.hpp"
+#include "analysis/straight_tet_mu.hpp"
+#include "analysis/symmetric3_lanes.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+
+CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*w)[8][3], double delta, double b) {
+  using namespace lanes3;
+  using L8 = Lanes<8>;
+  constexpr int kSlots = 32;
+  const int nv = domain.vertices, np = domain.points;
+  QV_ASSERT(nv >= 1 && nv <= 8 && np >= nv && np <= kSlots, nv << " vertices, " << np << " points");
+  CertifiedRatio out;
+  const double err = next_up((3 * (2 * b + delta) * delta + rounding_gamma(10) * 3 * b * b) * kSlack);
+  if (!(err < kMax) || !(b > 0)) return out;
+  // Slots: the vertices' points first (slot q: vertex q), then the others; the spare ones
+  // repeat slot 0.
+  std::array<int, kSlots> point{};
+  std::array<bool, kSlots> taken{};
+  int slots = 0;
+  for (int q = 0; q < nv; ++q) {
+    point[static_cast<std::size_t>(slots++)] = domain.pair_point[static_cast<std::size_t>(q)][static_cast<std::size_t>(q)];
+    taken[static_cast<std::size_t>(point[static_cast<std::size_t>(slots - 1)])] = true;
+  }
+  for (int p = 0; p < np; ++p)
+    if (!taken[static_cast<std::size_t>(p)]) point[static_cast<std::size_t>(slots++)] = p;
+  const int blocks = (np + 7) / 8;
+  for (int s = np; s < 8 * blocks; ++s) point[static_cast<std::size_t>(s)] = point[0];
+  // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
+  constexpr int kPairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
+  alignas(64) double m[6][kSlots];
+  for (int e = 0; e < 6; ++e) {
+    const auto& wx = w[kPairs[e][0]];
+    const auto& wy = w[kPairs[e][1]];
+    double sum[kSlots] = {};
+    for (int q = 0; q < nv; ++q)
+      for (int r = 0; r < nv; ++r)
+        sum[domain.pair_point[static_cast<std::size_t>(q)][static_cast<std::size_t>(r)]] +=
+            wx[q][0] * wy[r][0] + wx[q][1] * wy[r][1] + wx[q][2] * wy[r][2];
+    for (int s = 0; s < 8 * blocks; ++s) {
+      const auto p = static_cast<std::size_t>(point[static_cast<std::size_t>(s)]);
+      m[e][s] = sum[p] * domain.inverse_count[p];
+    }
+  }
+  // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp). The
+  // vertices' block is enclosed first; a later block only where the cheaper test does not
+  // certify all its lanes at least the least ratio so far, which then stays the bound
+  // (trilinear_hex_mu.cpp does the same).
+  L8 vertex_m[6];
+  for (int e = 0; e < 6; ++e) vertex_m[e] = load_lanes<8>(m[e]);
+  const ExtremeEigen<8> vertex_eig = extreme_eigen<8>(vertex_m, broadcast_lanes<8>(err));
+  if (mask_bits<8>(vertex_eig.ok & (vertex_eig.lo > 0)) != 0xffu) return out;
+  double lower = fold_min(down<8>(vertex_eig.lo / vertex_eig.hi), 1.0);
+  for (int block = 1; block < blocks; ++block) {
+    L8 mb[6];
+    for (int e = 0; e < 6; ++e) mb[e] = load_lanes<8>(&m[e][8 * block]);
+    if (lower > 0 && lower < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, lower)) == 0xffu) continue;
+    const ExtremeEigen<8> eig = extreme_eigen<8>(mb, broadcast_lanes<8>(err));
+    if (mask_bits<8>(eig.ok & (eig.lo > 0)) != 0xffu) return out;
+    lower = fold_min(down<8>(eig.lo / eig.hi), lower);
+  }
+  // Upper: Rayleigh quotients of W at the vertices (lanes 0 to nv - 1 of block 0).
+  L8 wv[3][3];
+  for (int j = 0; j < 3; ++j)
+    for (int c = 0; c < 3; ++c)
+      for (int l = 0; l < 8; ++l) wv[j][c][l] = w[j][l < nv ? l : 0][c];
+  Mask<8> vectors_ok;
+  const L8 upper = ratio_upper<8>(wv, vertex_m, vertex_eig.lo, vertex_eig.hi, broadcast_lanes<8>(delta), vectors_ok);
+  double best = 1;
+  for (int l = 0; l < nv; ++l) best = std::min(best, upper[l]);
+  out.lower = std::clamp(lower, 0.0, 1.0);
+  out.upper = std::clamp(best, 0.0, 1.0);
+  out.ok = out.lower <= out.upper;
+  return out;
+}
+
+CertifiedRatio columns_ratio(const VertexProducts& domain, const double (*col)[8][3], const double* rounding,
+                             const std::array<double, 9>& jinv) {
+  constexpr double kUnit = 0x1p-53;
+  constexpr double kSlack = lanes3::kSlack;
+  const int nv = domain.vertices;
+  double a[3] = {0, 0, 0}, scale = 0;  // per column, its largest |entry|
+  for (int c = 0; c < 3; ++c) {
+    for (int q = 0; q < nv; ++q)
+      for (int k = 0; k < 3; ++k) a[c] = std::max(a[c], std::abs(col[c][q][k]));
+    scale = std::max(scale, a[c]);
+  }
+  // Constant W: the closed form, two lanes (as one tetrahedron in mu_bounds).
+  Lanes<2> edges[9], margins[3];
+  double spread = 0;
+  for (int c = 0; c < 3; ++c) {
+    double beta = 0;
+    for (int q = 1; q < nv; ++q)
+      for (int k = 0; k < 3; ++k) beta = std::max(beta, std::abs(col[c][q][k] - col[c][0][k]));
+    spread = std::max(spread, beta);
+    margins[c] = broadcast_lanes<2>(next_up((beta + rounding[c]) * kSlack));
+    for (int k = 0; k < 3; ++k) edges[3 * c + k] = broadcast_lanes<2>(col[c][0][k]);
+  }
+  if (spread <= 1e-9 * scale) {
+    const StraightTetRatio<2> r = straight_tet_ratio<2>(edges, margins, jinv);
+    if ((r.ok & 1u) != 0) return {r.lower[0], r.upper[0], r.lower[0] <= r.upper[0]};
+  }
+  double w[3][8][3] = {};
+  double delta = 0, b = 0;
+  for (int j = 0; j < 3; ++j) {
+    double dj = 0, bj = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double s = std::abs(jinv[static_cast<std::size_t>(3 * c + j)]);
+      dj += s * (rounding[c] + 4 * kUnit * a[c]);
+      bj += s * a[c];
+    }
+    delta = std::max(delta, dj);
+    b = std::max(b, bj);
+    for (int q = 0; q < nv; ++q)
+      for (int k = 0; k < 3; ++k) {
+        double v = 0;
+        for (int c = 0; c < 3; ++c) v += jinv[static_cast<std::size_t>(3 * c + j)] * col[c][q][k];
+        w[j][q][k] = v;
+      }
+  }
+  delta = next_up(delta * kSlack);
+  return vertex_metric_ratio(domain, w, delta, next_up((b + delta) * kSlack));
+}
+
+}  // namespace quadval

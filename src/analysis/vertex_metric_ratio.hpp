@@ -1,0 +1,52 @@
+#pragma once
+// Bounds of R = lambda_min / lambda_max of M = W^T W over an element whose W has degree 1
+// in each factor of its reference domain (a first-order pyramid in cube coordinates, a
+// first-order prism), from W's control values at the domain's vertices alone, in SIMD
+// lanes (symmetric3_lanes.hpp). Internal to src/analysis; used by linear_pyramid_mu.cpp
+// and linear_prism_mu.cpp (trilinear_hex_mu.cpp does the same with the hexahedron's own
+// faster products).
+//
+// M has degree 2 in each factor: its control value at a point p is the mean of
+// W(q)^T W(q') over the vertex pairs (q, q') whose multi-indices sum to p (Paper V Prop. 4;
+// a simplex factor's pair (i, j) gives e_i + e_j, a line's gives l + l'). The lower bound is
+// the least certified ratio of those control matrices (the concavity argument of
+// mu_control_bound.hpp); the upper bound, Rayleigh quotients of W at the vertices (values
+// of W there), at the eigenvectors of their metrics (the control values at the points
+// q + q).
+//
+// Rounding: each control value is a mean of at most 4 sums of 3 products, within gamma_10
+// of their terms' magnitudes (at most 3 b^2, b >= every |W| entry), plus the propagated
+// entry errors 3 (2 b + delta) delta.
+#include <array>
+#include <vector>
+
+namespace quadval {
+
+struct CertifiedRatio {
+  double lower = 0, upper = 1;  ///< lower <= min R <= upper over the element, where ok
+  bool ok = false;              ///< false: a certification failed; use the general path
+};
+
+/// The vertices and M's control points of a reference domain.
+struct VertexProducts {
+  int vertices = 0;                              ///< at most 8
+  int points = 0;                                ///< M's control points, at most 32
+  std::vector<std::array<int, 8>> pair_point;    ///< [q][q']: the point of the pair
+  std::vector<double> inverse_count;             ///< per point: 1 / (pairs summing to it)
+};
+
+/// R's bounds from W's control values w[j][q][c] (column j, vertex q, coordinate c), each
+/// within delta of the exact one, every |entry| at most b. Not ok where a control matrix
+/// is not certified positive definite or an eigenvalue step fails.
+CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*w)[8][3], double delta, double b);
+
+/// R's bounds for W = J Jinv (any common scale of J), from J's columns' control values at
+/// the vertices, col[c][q][k], each entry within rounding[c] of the exact one. Where the
+/// columns agree at every vertex to 1e-9 (W constant: a pyramid's parallelogram base, a
+/// prism's translated top), the closed form of straight_tet_mu.hpp with each column's
+/// spread as its margin; else W's control values (a sum of 3 products per entry, within
+/// sum_c |Jinv_cj| (rounding[c] + 4u |col_c|)) go to vertex_metric_ratio.
+CertifiedRatio columns_ratio(const VertexProducts& domain, const double (*col)[8][3], const double* rounding,
+                             const std::array<double, 9>& jinv);
+
+}  // namespace quadval
