@@ -16,22 +16,10 @@ constexpr double kUnit = 0x1p-53;
 // points: the triangle's degree-2 multi-index of a pair (i, i') (0, 1, 2 for 2 e_i; 3, 4, 5
 // for e_0 + e_1, e_0 + e_2, e_1 + e_2) plus 6 (l + l').
 const VertexProducts& prism() {
-  static const VertexProducts domain = [] {
+  static const VertexProducts domain = vertex_products(6, 18, [](int q, int r) {
     constexpr int kTriangle[3][3] = {{0, 3, 4}, {3, 1, 5}, {4, 5, 2}};
-    VertexProducts d;
-    d.vertices = 6;
-    d.points = 18;
-    d.pair_point.resize(6);
-    std::array<int, 18> count{};
-    for (int q = 0; q < 6; ++q)
-      for (int r = 0; r < 6; ++r) {
-        const int p = kTriangle[q % 3][r % 3] + 6 * (q / 3 + r / 3);
-        d.pair_point[static_cast<std::size_t>(q)][static_cast<std::size_t>(r)] = p;
-        ++count[static_cast<std::size_t>(p)];
-      }
-    for (const int c : count) d.inverse_count.push_back(1.0 / c);
-    return d;
-  }();
+    return kTriangle[q % 3][r % 3] + 6 * (q / 3 + r / 3);
+  });
   return domain;
 }
 

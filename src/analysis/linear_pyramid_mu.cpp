@@ -16,21 +16,8 @@ constexpr double kUnit = 0x1p-53;
 
 // The square's vertices q = i + 2 j and M's control points a + 3 b.
 const VertexProducts& square() {
-  static const VertexProducts domain = [] {
-    VertexProducts d;
-    d.vertices = 4;
-    d.points = 9;
-    d.pair_point.resize(4);
-    std::array<int, 9> count{};
-    for (int q = 0; q < 4; ++q)
-      for (int r = 0; r < 4; ++r) {
-        const int p = (q & 1) + (r & 1) + 3 * ((q >> 1) + (r >> 1));
-        d.pair_point[static_cast<std::size_t>(q)][static_cast<std::size_t>(r)] = p;
-        ++count[static_cast<std::size_t>(p)];
-      }
-    for (const int c : count) d.inverse_count.push_back(1.0 / c);
-    return d;
-  }();
+  static const VertexProducts domain =
+      vertex_products(4, 9, [](int q, int r) { return (q & 1) + (r & 1) + 3 * ((q >> 1) + (r >> 1)); });
   return domain;
 }
 

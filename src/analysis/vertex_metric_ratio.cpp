@@ -14,39 +14,27 @@ namespace quadval {
 CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*w)[8][3], double delta, double b) {
   using namespace lanes3;
   using L8 = Lanes<8>;
-  constexpr int kSlots = 32;
-  const int nv = domain.vertices, np = domain.points;
-  QV_ASSERT(nv >= 1 && nv <= 8 && np >= nv && np <= kSlots, nv << " vertices, " << np << " points");
+  const int nv = domain.vertices;
+  QV_ASSERT(nv >= 1 && nv <= 8 && domain.slots >= nv && domain.slots <= VertexProducts::kSlots,
+            nv << " vertices, " << domain.slots << " slots");
   CertifiedRatio out;
   const double err = next_up((3 * (2 * b + delta) * delta + rounding_gamma(10) * 3 * b * b) * kSlack);
   if (!(err < kMax) || !(b > 0)) return out;
-  // Slots: the vertices' points first (slot q: vertex q), then the others; the spare ones
-  // repeat slot 0.
-  std::array<int, kSlots> point{};
-  std::array<bool, kSlots> taken{};
-  int slots = 0;
-  for (int q = 0; q < nv; ++q) {
-    point[static_cast<std::size_t>(slots++)] = domain.pair_point[static_cast<std::size_t>(q)][static_cast<std::size_t>(q)];
-    taken[static_cast<std::size_t>(point[static_cast<std::size_t>(slots - 1)])] = true;
-  }
-  for (int p = 0; p < np; ++p)
-    if (!taken[static_cast<std::size_t>(p)]) point[static_cast<std::size_t>(slots++)] = p;
-  const int blocks = (np + 7) / 8;
-  for (int s = np; s < 8 * blocks; ++s) point[static_cast<std::size_t>(s)] = point[0];
-  // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
+  // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot: the products
+  // of every vertex pair, then each slot's mean of its pairs'.
   constexpr int kPairs[6][2] = {{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}};
-  alignas(64) double m[6][kSlots];
+  alignas(64) double m[6][VertexProducts::kSlots];
   for (int e = 0; e < 6; ++e) {
     const auto& wx = w[kPairs[e][0]];
     const auto& wy = w[kPairs[e][1]];
-    double sum[kSlots] = {};
+    double dot[64];
     for (int q = 0; q < nv; ++q)
-      for (int r = 0; r < nv; ++r)
-        sum[domain.pair_point[static_cast<std::size_t>(q)][static_cast<std::size_t>(r)]] +=
-            wx[q][0] * wy[r][0] + wx[q][1] * wy[r][1] + wx[q][2] * wy[r][2];
-    for (int s = 0; s < 8 * blocks; ++s) {
-      const auto p = static_cast<std::size_t>(point[static_cast<std::size_t>(s)]);
-      m[e][s] = sum[p] * domain.inverse_count[p];
+      for (int r = 0; r < nv; ++r) dot[q * nv + r] = wx[q][0] * wy[r][0] + wx[q][1] * wy[r][1] + wx[q][2] * wy[r][2];
+    for (int s = 0; s < domain.slots; ++s) {
+      const auto& pairs = domain.pairs[static_cast<std::size_t>(s)];
+      double sum = dot[pairs[0]];
+      for (int t = 1; t < domain.pair_count[static_cast<std::size_t>(s)]; ++t) sum += dot[pairs[static_cast<std::size_t>(t)]];
+      m[e][s] = sum * domain.inverse_count[static_cast<std::size_t>(s)];
     }
   }
   // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp). The
@@ -58,7 +46,7 @@ CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*
   const ExtremeEigen<8> vertex_eig = extreme_eigen<8>(vertex_m, broadcast_lanes<8>(err));
   if (mask_bits<8>(vertex_eig.ok & (vertex_eig.lo > 0)) != 0xffu) return out;
   double lower = fold_min(down<8>(vertex_eig.lo / vertex_eig.hi), 1.0);
-  for (int block = 1; block < blocks; ++block) {
+  for (int block = 1; block < domain.slots / 8; ++block) {
     L8 mb[6];
     for (int e = 0; e < 6; ++e) mb[e] = load_lanes<8>(&m[e][8 * block]);
     if (lower > 0 && lower < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, lower)) == 0xffu) continue;

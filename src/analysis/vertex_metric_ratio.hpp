@@ -18,7 +18,8 @@
 // of their terms' magnitudes (at most 3 b^2, b >= every |W| entry), plus the propagated
 // entry errors 3 (2 b + delta) delta.
 #include <array>
-#include <vector>
+
+#include "quadval/error.hpp"
 
 namespace quadval {
 
@@ -27,13 +28,50 @@ struct CertifiedRatio {
   bool ok = false;              ///< false: a certification failed; use the general path
 };
 
-/// The vertices and M's control points of a reference domain.
+/// The vertices and M's control points of a reference domain, and the lane slots of the
+/// points: the vertices' own points (q + q) first, slot q for vertex q, then the others;
+/// the spare slots of the last block of 8 repeat slot 0.
 struct VertexProducts {
-  int vertices = 0;                              ///< at most 8
-  int points = 0;                                ///< M's control points, at most 32
-  std::vector<std::array<int, 8>> pair_point;    ///< [q][q']: the point of the pair
-  std::vector<double> inverse_count;             ///< per point: 1 / (pairs summing to it)
+  static constexpr int kSlots = 32;
+  int vertices = 0;  ///< at most 8
+  int points = 0;    ///< M's control points, at most kSlots
+  int slots = 0;     ///< points rounded up to whole blocks of 8
+  /// Per slot: the vertex pairs (q, q') summing to its point, as q * vertices + q' (at most 4),
+  /// their count, and 1 / count.
+  std::array<std::array<int, 4>, kSlots> pairs{};
+  std::array<int, kSlots> pair_count{};
+  std::array<double, kSlots> inverse_count{};
 };
+
+/// The domain with these vertices and points, pair_point(q, q') the point of a pair.
+template <class PairPoint>
+VertexProducts vertex_products(int vertices, int points, PairPoint pair_point) {
+  VertexProducts d;
+  d.vertices = vertices;
+  d.points = points;
+  d.slots = (points + 7) / 8 * 8;
+  std::array<int, VertexProducts::kSlots> slot_point{};
+  std::array<bool, VertexProducts::kSlots> placed{};
+  int s = 0;
+  for (int q = 0; q < vertices; ++q) {
+    slot_point[static_cast<std::size_t>(s++)] = pair_point(q, q);
+    placed[static_cast<std::size_t>(pair_point(q, q))] = true;
+  }
+  for (int p = 0; p < points; ++p)
+    if (!placed[static_cast<std::size_t>(p)]) slot_point[static_cast<std::size_t>(s++)] = p;
+  for (; s < d.slots; ++s) slot_point[static_cast<std::size_t>(s)] = slot_point[0];
+  for (s = 0; s < d.slots; ++s) {
+    auto& count = d.pair_count[static_cast<std::size_t>(s)];
+    for (int q = 0; q < vertices; ++q)
+      for (int r = 0; r < vertices; ++r)
+        if (pair_point(q, r) == slot_point[static_cast<std::size_t>(s)]) {
+          QV_ASSERT(count < 4, "more than 4 vertex pairs at a point");
+          d.pairs[static_cast<std::size_t>(s)][static_cast<std::size_t>(count++)] = q * vertices + r;
+        }
+    d.inverse_count[static_cast<std::size_t>(s)] = 1.0 / count;
+  }
+  return d;
+}
 
 /// R's bounds from W's control values w[j][q][c] (column j, vertex q, coordinate c), each
 /// within delta of the exact one, every |entry| at most b. Not ok where a control matrix
