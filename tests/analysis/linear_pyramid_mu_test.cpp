@@ -11,33 +11,18 @@
 #include <random>
 
 #include "analysis/linear_pyramid_mu.hpp"
-#include "analysis/mu_constant.hpp"
 #include "analysis/mu_space.hpp"
-#include "jacobian_test_util.hpp"
-#include "mu_test_util.hpp"
-#include "quadval/element_type.hpp"
-#include "quadval/jacobian_bounds.hpp"
-#include "quadval/lagrange_basis.hpp"
-#include "quadval/mu_bounds.hpp"
+#include "first_order_mu_test_util.hpp"
 
 namespace quadval {
 namespace {
 
-const ElementType& pyramid5() {
-  for (const ElementType& t : element_types())
-    if (t.family == ElementFamily::pyramid && t.num_nodes == 5) return t;
-  throw std::logic_error("no first-order pyramid");
-}
+const ElementType& pyramid5() { return test::first_order(ElementFamily::pyramid); }
 
 const std::array<double, 9>& jinv() { return mu_space(pyramid5()).ideal_inverse(); }
 
-// A random first-order pyramid (random_element: an affine image of the reference one, its
-// nodes moved by up to `amplitude`), at scales from 1e-6 to 1e5.
 std::vector<double> random_pyramid(int e, double amplitude, std::mt19937& rng) {
-  std::vector<double> x = test::random_element(pyramid5(), amplitude, rng);
-  const double scale = e % 7 == 0 ? 1e-6 : e % 11 == 0 ? 1e5 : 1;
-  for (double& v : x) v *= scale;
-  return x;
+  return test::random_scaled_element(pyramid5(), e, amplitude, rng);
 }
 
 // Points of the base square at zeta = 0, where W takes every value it takes on the pyramid.
@@ -50,40 +35,13 @@ std::vector<RefPoint> base_points(int n) {
 
 TEST(LinearPyramidMu, BoundsEncloseSampledAndCornerValues) {
   std::mt19937 rng(41);
-  const ElementType& t = pyramid5();
-  const LagrangeBasis& basis = lagrange_basis(t);
   auto points = test::dense_points(ElementFamily::pyramid, 8, 200, rng);
   const auto square = base_points(16);
   points.insert(points.end(), square.begin(), square.end());
-  const auto corners = base_points(1);
-  BoundsOptions bounds_options;
-  BoundsWorkspace workspace;
-  int valid = 0, ok = 0, settled = 0;
-  for (int e = 0; e < 600; ++e) {
-    const double amplitude = e % 3 == 0 ? 0.02 : e % 3 == 1 ? 0.15 : 0.4;
-    const auto x = random_pyramid(e, amplitude, rng);
-    if (jacobian_bounds(t, x, bounds_options, workspace).validity != Validity::valid) continue;
-    ++valid;
-    const CertifiedRatio r = linear_pyramid_ratio(x, jinv());
-    if (!r.ok) continue;
-    ++ok;
-    ASSERT_LE(0.0, r.lower);
-    ASSERT_LE(r.lower, r.upper);
-    ASSERT_LE(r.upper, 1.0);
-    const test::SampledMu sampled = test::sample_mu(basis, x, points);
-    ASSERT_FALSE(sampled.j_nonpositive);
-    double corner_min = 1;
-    for (const RefPoint& p : corners) corner_min = std::min(corner_min, test::pointwise_mu(basis, x, p));
-    const double corner_r = corner_min * corner_min;
-    EXPECT_LE(r.lower, sampled.lo * sampled.lo * (1 + 1e-12)) << "element " << e;
-    EXPECT_GE(r.upper, corner_r * (1 - 1e-12)) << "element " << e;
-    EXPECT_LE(r.upper, corner_r * (1 + 1e-9)) << "element " << e;
-    if (std::sqrt(r.upper) - std::sqrt(r.lower) <= 1e-2) ++settled;
-  }
-  std::printf("[linear pyramid mu] %d valid, %d certified, %d within 1e-2\n", valid, ok, settled);
-  EXPECT_GE(valid, 300);
-  EXPECT_GE(ok, valid * 98 / 100);
-  EXPECT_GE(settled, valid / 2);
+  test::check_against_samples(
+      pyramid5(), [](std::span<const double> x) { return linear_pyramid_ratio(x, jinv()); },
+      [](int e, std::mt19937& r) { return random_pyramid(e, e % 3 == 0 ? 0.02 : e % 3 == 1 ? 0.15 : 0.4, r); }, 600,
+      300, points, base_points(1), rng);
 }
 
 // The control matrices of M = W^T W, independently: M sampled at the 3 x 3 grid of the base
@@ -154,28 +112,10 @@ TEST(LinearPyramidMu, ParallelogramBasesGetTheirConstantRatio) {
   EXPECT_GE(checked, 150);
 }
 
-// mu_bounds with the kernel (the default) and with the general path alone.
 TEST(LinearPyramidMu, AgreesWithTheGeneralPath) {
   std::mt19937 rng(53);
-  const ElementType& t = pyramid5();
-  QualityOptions opt;
-  opt.abs_tol = 1e-2;
-  int root = 0;
-  for (int e = 0; e < 300; ++e) {
-    const auto x = random_pyramid(e, e % 2 == 0 ? 0.05 : 0.2, rng);
-    const QualityBounds fast = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(false);
-    const QualityBounds general = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(true);
-    EXPECT_LE(fast.lower, general.upper) << "element " << e;
-    EXPECT_LE(general.lower, fast.upper) << "element " << e;
-    if (fast.subdivisions == 0 && general.subdivisions == 0 && fast.upper > 0) {
-      ++root;
-      EXPECT_NEAR(fast.lower, general.lower, 1e-10) << "element " << e;
-      EXPECT_NEAR(fast.upper, general.upper, 1e-10) << "element " << e;
-    }
-  }
-  EXPECT_GE(root, 100);
+  test::check_against_general_path(
+      pyramid5(), [](int e, std::mt19937& r) { return random_pyramid(e, e % 2 == 0 ? 0.05 : 0.2, r); }, 300, 100, rng);
 }
 
 }  // namespace

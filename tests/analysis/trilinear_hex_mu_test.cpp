@@ -9,75 +9,26 @@
 #include <cmath>
 #include <random>
 
-#include "analysis/mu_constant.hpp"
 #include "analysis/trilinear_hex_mu.hpp"
-#include "jacobian_test_util.hpp"
-#include "mu_test_util.hpp"
-#include "quadval/element_type.hpp"
-#include "quadval/jacobian_bounds.hpp"
-#include "quadval/lagrange_basis.hpp"
-#include "quadval/mu_bounds.hpp"
+#include "first_order_mu_test_util.hpp"
 
 namespace quadval {
 namespace {
 
-const ElementType& hexahedron8() {
-  for (const ElementType& t : element_types())
-    if (t.family == ElementFamily::hexahedron && t.num_nodes == 8) return t;
-  throw std::logic_error("no first-order hexahedron");
-}
+const ElementType& hexahedron8() { return test::first_order(ElementFamily::hexahedron); }
 
-// A random first-order hexahedron: an affine image of the reference cube (random_element)
-// with its vertices moved by up to `amplitude`, at scales from 1e-6 to 1e5.
 std::vector<double> random_hexahedron(int e, double amplitude, std::mt19937& rng) {
-  std::vector<double> x = test::random_element(hexahedron8(), amplitude, rng);
-  const double scale = e % 7 == 0 ? 1e-6 : e % 11 == 0 ? 1e5 : 1;
-  for (double& v : x) v *= scale;
-  return x;
-}
-
-std::vector<RefPoint> corner_points() {
-  std::vector<RefPoint> p;
-  for (const RefPoint& v : reference_vertices(ElementFamily::hexahedron)) p.push_back(v);
-  return p;
+  return test::random_scaled_element(hexahedron8(), e, amplitude, rng);
 }
 
 TEST(TrilinearHexMu, BoundsEncloseSampledAndCornerValues) {
   std::mt19937 rng(17);
-  const ElementType& t = hexahedron8();
-  const LagrangeBasis& basis = lagrange_basis(t);
   const auto points = test::dense_points(ElementFamily::hexahedron, 10, 200, rng);
-  const auto corners = corner_points();
-  BoundsOptions bounds_options;
-  BoundsWorkspace workspace;
-  int valid = 0, ok = 0, settled = 0;
-  for (int e = 0; e < 600; ++e) {
-    const double amplitude = e % 3 == 0 ? 0.02 : e % 3 == 1 ? 0.15 : 0.4;
-    const auto x = random_hexahedron(e, amplitude, rng);
-    if (jacobian_bounds(t, x, bounds_options, workspace).validity != Validity::valid) continue;
-    ++valid;
-    const CertifiedRatio r = trilinear_hex_ratio(x);
-    if (!r.ok) continue;
-    ++ok;
-    ASSERT_LE(0.0, r.lower);
-    ASSERT_LE(r.lower, r.upper);
-    ASSERT_LE(r.upper, 1.0);
-    const test::SampledMu sampled = test::sample_mu(basis, x, points);
-    ASSERT_FALSE(sampled.j_nonpositive);
-    double corner_min = 1;
-    for (const RefPoint& p : corners) corner_min = std::min(corner_min, test::pointwise_mu(basis, x, p));
-    const double corner_r = corner_min * corner_min;
-    // lower <= R everywhere; upper >= the least corner value (>= min R), and within
-    // rounding of it (Rayleigh quotients at good eigenvectors).
-    EXPECT_LE(r.lower, sampled.lo * sampled.lo * (1 + 1e-12)) << "element " << e;
-    EXPECT_GE(r.upper, corner_r * (1 - 1e-12)) << "element " << e;
-    EXPECT_LE(r.upper, corner_r * (1 + 1e-9)) << "element " << e;
-    if (std::sqrt(r.upper) - std::sqrt(r.lower) <= 1e-2) ++settled;
-  }
-  std::printf("[trilinear hex mu] %d valid, %d certified, %d within 1e-2\n", valid, ok, settled);
-  EXPECT_GE(valid, 500);
-  EXPECT_GE(ok, valid * 98 / 100);
-  EXPECT_GE(settled, valid / 2);
+  const auto corners = reference_vertices(ElementFamily::hexahedron);
+  test::check_against_samples(
+      hexahedron8(), [](std::span<const double> x) { return trilinear_hex_ratio(x); },
+      [](int e, std::mt19937& r) { return random_hexahedron(e, e % 3 == 0 ? 0.02 : e % 3 == 1 ? 0.15 : 0.4, r); },
+      600, 500, points, {corners.begin(), corners.end()}, rng);
 }
 
 // The control matrices of M = W^T W, independently: M sampled (through the Lagrange
@@ -156,30 +107,11 @@ TEST(TrilinearHexMu, ParallelepipedsGetTheirStretchRatio) {
   }
 }
 
-// mu_bounds with the kernel (the default) and with the general path alone: overlapping
-// intervals, the same elements settled at the root, and bounds equal to rounding.
 TEST(TrilinearHexMu, AgreesWithTheGeneralPath) {
   std::mt19937 rng(31);
-  const ElementType& t = hexahedron8();
-  QualityOptions opt;
-  opt.abs_tol = 1e-2;
-  int root = 0;
-  for (int e = 0; e < 300; ++e) {
-    const auto x = random_hexahedron(e, e % 2 == 0 ? 0.05 : 0.2, rng);
-    const QualityBounds fast = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(false);
-    const QualityBounds general = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(true);
-    EXPECT_LE(fast.lower, general.upper) << "element " << e;
-    EXPECT_LE(general.lower, fast.upper) << "element " << e;
-    EXPECT_EQ(fast.subdivisions == 0, general.subdivisions == 0) << "element " << e;
-    if (fast.subdivisions == 0 && general.subdivisions == 0 && fast.upper > 0) {
-      ++root;
-      EXPECT_NEAR(fast.lower, general.lower, 1e-10) << "element " << e;
-      EXPECT_NEAR(fast.upper, general.upper, 1e-10) << "element " << e;
-    }
-  }
-  EXPECT_GE(root, 100);
+  test::check_against_general_path(
+      hexahedron8(), [](int e, std::mt19937& r) { return random_hexahedron(e, e % 2 == 0 ? 0.05 : 0.2, r); }, 300,
+      100, rng);
 }
 
 }  // namespace
