@@ -183,6 +183,18 @@ std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span
   return mu_from_ratio(ratio.lower, ratio.upper, tol);
 }
 
+// First-order hexahedra, pyramids and prisms: R's bounds from their control matrices at
+// the root, in lanes (trilinear_hex_mu.hpp, linear_pyramid_mu.hpp, linear_prism_mu.hpp);
+// nothing for other types.
+std::optional<CertifiedRatio> first_order_ratio(const MuSpace& space, std::span<const double> nodes) {
+  const ElementType& type = space.type();
+  const auto& jinv = space.ideal_inverse();
+  if (type.family == ElementFamily::hexahedron && type.num_nodes == 8) return trilinear_hex_ratio(nodes);
+  if (type.family == ElementFamily::pyramid && type.num_nodes == 5) return linear_pyramid_ratio(nodes, jinv);
+  if (type.family == ElementFamily::prism && type.num_nodes == 6) return linear_prism_ratio(nodes, jinv);
+  return std::nullopt;
+}
+
 }  // namespace
 
 void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
@@ -250,23 +262,8 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   if (validity == Validity::valid && mu_constant_path_enabled()) {
     if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol, known)) return *straight;
     if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
-    // First-order hexahedra, pyramids and prisms: their control matrices at the root, in
-    // lanes.
-    if (type.family == ElementFamily::hexahedron && type.num_nodes == 8) {
-      const CertifiedRatio hex = trilinear_hex_ratio(nodes);
-      if (hex.ok)
-        if (const auto mu = mu_from_ratio(hex.lower, hex.upper, options.abs_tol)) return *mu;
-    }
-    if (type.family == ElementFamily::pyramid && type.num_nodes == 5) {
-      const CertifiedRatio pyramid = linear_pyramid_ratio(nodes, space.ideal_inverse());
-      if (pyramid.ok)
-        if (const auto mu = mu_from_ratio(pyramid.lower, pyramid.upper, options.abs_tol)) return *mu;
-    }
-    if (type.family == ElementFamily::prism && type.num_nodes == 6) {
-      const CertifiedRatio prism = linear_prism_ratio(nodes, space.ideal_inverse());
-      if (prism.ok)
-        if (const auto mu = mu_from_ratio(prism.lower, prism.upper, options.abs_tol)) return *mu;
-    }
+    if (const auto ratio = first_order_ratio(space, nodes); ratio && ratio->ok)
+      if (const auto mu = mu_from_ratio(ratio->lower, ratio->upper, options.abs_tol)) return *mu;
   }
   const double err0 = element_w(space, nodes, pool.data());
   // Constant W (straight-sided simplices, parallelograms, parallelepipeds): W's control

@@ -14,11 +14,10 @@ namespace quadval {
 namespace {
 
 using namespace lanes3;
-using L8 = Lanes<8>;
 
 constexpr double kUnit = 0x1p-53;
 constexpr int kPoints = 27;
-constexpr int kSlots = 32;  // 4 blocks of 8 lanes; the spare lanes repeat point 0
+constexpr int kSlots = VertexProducts::kSlots;  // 4 blocks of 8 lanes; the spare ones repeat point 0
 
 // Gmsh's vertex at Bernstein index (i, j, k), i + 2 j + 4 k.
 constexpr int kNode[8] = {0, 1, 3, 2, 4, 5, 7, 6};
@@ -128,42 +127,13 @@ CertifiedRatio trilinear_hex_ratio(std::span<const double> x) {
     }
   const double delta = next_up(2 * kUnit * a * kSlack);
   const double err = next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
-  CertifiedRatio out;
-  if (!(err < kMax) || !(a > 0)) return out;
+  if (!(err < kMax) || !(a > 0)) return {};
   // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
   alignas(64) double m[6][kSlots];
   for (int x = 0; x < 3; ++x) diagonal_entry(w[x], x, lay, m[x]);
   for (int e = 0; e < 3; ++e) cross_entry(w, e, lay, m[3 + e]);
-  // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp). The
-  // corners (block 0) are enclosed first; a later block is enclosed only where the cheaper
-  // test does not certify all its lanes at least their least ratio, which then stays the
-  // bound (a good element's later blocks mostly pass: hex_box_30 mu 30.3 -> 24.6 ms).
-  L8 corner_m[6];
-  for (int e = 0; e < 6; ++e) corner_m[e] = load_lanes<8>(m[e]);
-  const ExtremeEigen<8> corners = extreme_eigen<8>(corner_m, broadcast_lanes<8>(err));
-  const Mask<8> corner_ok = corners.ok & (corners.lo > 0);
-  if (mask_bits<8>(corner_ok) != 0xffu) return out;
-  double lower = fold_min(down<8>(corners.lo / corners.hi), 1.0);
-  for (int b = 1; b < kSlots / 8; ++b) {
-    L8 mb[6];
-    for (int e = 0; e < 6; ++e) mb[e] = load_lanes<8>(&m[e][8 * b]);
-    if (lower > 0 && lower < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, lower)) == 0xffu) continue;
-    const ExtremeEigen<8> eig = extreme_eigen<8>(mb, broadcast_lanes<8>(err));
-    const Mask<8> ok = eig.ok & (eig.lo > 0);
-    if (mask_bits<8>(ok) != 0xffu) return out;
-    lower = fold_min(down<8>(eig.lo / eig.hi), lower);
-  }
-  // Upper: Rayleigh quotients of W at the corners (block 0: slot q is corner q).
-  L8 wc[3][3];
-  for (int c = 0; c < 3; ++c)
-    for (int k = 0; k < 3; ++k)
-      for (int q = 0; q < 8; ++q) wc[c][k][q] = w[c][q][k];
-  Mask<8> vectors_ok;
-  const L8 upper = ratio_upper<8>(wc, corner_m, corners.lo, corners.hi, broadcast_lanes<8>(delta), vectors_ok);
-  out.lower = std::clamp(lower, 0.0, 1.0);
-  out.upper = std::clamp(fold_min(upper, 1.0), 0.0, 1.0);
-  out.ok = out.lower <= out.upper;
-  return out;
+  // The corners are slots 0-7 (vertex q at slot q), as control_matrix_ratio wants them.
+  return control_matrix_ratio(m, kSlots, 8, w, err, delta);
 }
 
 }  // namespace quadval

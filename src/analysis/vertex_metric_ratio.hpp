@@ -78,6 +78,13 @@ VertexProducts vertex_products(int vertices, int points, PairPoint pair_point) {
 /// is not certified positive definite or an eigenvalue step fails.
 CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*w)[8][3], double delta, double b);
 
+/// The lane part of vertex_metric_ratio, for callers with their own products
+/// (trilinear_hex_mu.cpp): R's bounds from M's control values m[e][s] (entries m00, m11,
+/// m22, m01, m02, m12; slot s, vertex q's own point at slot q, `slots` a multiple of 8),
+/// each within err of the exact one, and W's vertex values w[j][q][c] within delta.
+CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], int slots, int vertices,
+                                    const double (*w)[8][3], double err, double delta);
+
 /// R's bounds for W = J Jinv (any common scale of J), from J's columns' control values at
 /// the vertices, col[c][q][k], each entry within rounding[c] of the exact one. Where the
 /// columns agree at every vertex to 1e-9 (W constant: a pyramid's parallelogram base, a
