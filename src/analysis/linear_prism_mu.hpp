@@ -25,8 +25,9 @@
 namespace quadval {
 
 /// R's bounds for the prism with these 6 nodes (x, y, z each, Gmsh order), J > 0 proven
-/// on it by the caller. Not ok where a control matrix is not certified positive definite
-/// or an eigenvalue step fails (a nearly degenerate element).
+/// on it by the caller. Not ok where a vertex's metric is not certified positive
+/// definite or its eigenvalue step fails (a nearly degenerate element); lower is 0 where
+/// another control matrix is not (vertex_metric_ratio.hpp).
 /// @param jinv  the ideal prism's inverse Jacobian (MuSpace::ideal_inverse)
 CertifiedRatio linear_prism_ratio(std::span<const double> x, const std::array<double, 9>& jinv);
 

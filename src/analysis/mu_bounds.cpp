@@ -45,6 +45,10 @@ struct Subdomain {
 
 thread_local int control_mode = 2;
 
+// Subdivisions after which the degree-12n certificate may take over from the control bound
+// (see mu_bounds_given).
+constexpr int kCertificateAfter = 24;
+
 struct MuScratch {
   MuMetric metric;
   std::vector<double> pool;
@@ -102,9 +106,6 @@ double element_w(const MuSpace& space, std::span<const double> x, double* w) {
   }
   return rounding_gamma(n + dim + 9) * worst * range * (1 + 1e-12);
 }
-
-double sqrt_down(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_down(sqrt_rn(r))); }
-double sqrt_up(double r) { return r <= 0 ? 0.0 : std::min(1.0, next_up(sqrt_rn(r))); }
 
 bool handled_family(ElementFamily f) {
   switch (f) {
@@ -195,6 +196,20 @@ std::optional<CertifiedRatio> first_order_ratio(const MuSpace& space, std::span<
   return std::nullopt;
 }
 
+// A first-order hexahedron the root did not settle, refined in its own kernel
+// (refine_trilinear_hex_ratio) for as many subdivisions (3 halvings each, as the general
+// path counts them) as the general path refines before its certificate takes over;
+// nothing where that does not settle it.
+std::optional<QualityBounds> refined_hex_mu(std::span<const double> nodes, const CertifiedRatio& root,
+                                            const QualityOptions& options) {
+  const RefinedRatio refined = refine_trilinear_hex_ratio(
+      nodes, root, options.abs_tol, 3 * std::min(kCertificateAfter, options.max_subdivisions));
+  if (!refined.settled) return std::nullopt;
+  auto mu = mu_from_ratio(refined.ratio.lower, refined.ratio.upper, options.abs_tol);
+  if (mu) mu->subdivisions = (refined.halvings + 2) / 3;
+  return mu;
+}
+
 }  // namespace
 
 void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
@@ -262,8 +277,11 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   if (validity == Validity::valid && mu_constant_path_enabled()) {
     if (const auto straight = straight_simplex_mu(space, nodes, pool.data(), options.abs_tol, known)) return *straight;
     if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes, options.abs_tol, known)) return *bilinear;
-    if (const auto ratio = first_order_ratio(space, nodes); ratio && ratio->ok)
+    if (const auto ratio = first_order_ratio(space, nodes); ratio && ratio->ok) {
       if (const auto mu = mu_from_ratio(ratio->lower, ratio->upper, options.abs_tol)) return *mu;
+      if (type.family == ElementFamily::hexahedron)
+        if (const auto mu = refined_hex_mu(nodes, *ratio, options)) return *mu;
+    }
   }
   const double err0 = element_w(space, nodes, pool.data());
   // Constant W (straight-sided simplices, parallelograms, parallelepipeds): W's control
@@ -315,7 +333,6 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // relative accuracy), and only where the control bound falls short.
   // Types above mu_certificate_max_order have no certificate (mu_space.hpp): the control
   // bound alone, whatever mode was asked for.
-  constexpr int kCertificateAfter = 24;
   const int mode = space.has_certificate() ? control_mode : 1;
   // Halving (not tetrahedra) with the control bound: each subdomain's slot also holds M's
   // control values, halved with W's (the same bisection sequence: M's space has W's

@@ -6,7 +6,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <utility>
+#include <vector>
 
+#include "analysis/sqrt_rn.hpp"
 #include "analysis/symmetric3_lanes.hpp"
 #include "quadval/error.hpp"
 
@@ -108,13 +112,36 @@ void cross_entry(const double (*w)[8][3], int e, const Layout& lay, double* out)
   for (int t = 0; t < kSlots; ++t) out[t] = raised[source[static_cast<std::size_t>(t)]];
 }
 
-}  // namespace
-
-CertifiedRatio trilinear_hex_ratio(std::span<const double> x) {
-  QV_ASSERT(x.size() == 24, x.size() << " coordinates for a first-order hexahedron");
+// R's bounds on a box whose columns' control values w (column, vertex, coordinate) are
+// within delta of the exact ones.
+CertifiedRatio box_ratio(const double (*w)[8][3], double delta, double enough = 1) {
   const Layout& lay = layout();
-  // Column c's control value at vertex q: the edge along direction c through q.
+  double a = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int q = 0; q < 8; ++q)
+      for (int k = 0; k < 3; ++k) a = std::max(a, std::abs(w[c][q][k]));
+  const double err = next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
+  if (!(err < kMax) || !(a > 0)) return {};
+  // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
+  alignas(64) double m[6][kSlots];
+  for (int x = 0; x < 3; ++x) diagonal_entry(w[x], x, lay, m[x]);
+  for (int e = 0; e < 3; ++e) cross_entry(w, e, lay, m[3 + e]);
+  // The corners are slots 0-7 (vertex q at slot q), as control_matrix_ratio wants them.
+  return control_matrix_ratio(m, kSlots, 8, w, err, delta, enough);
+}
+
+// A box of the reference cube: J's columns' control values on it, their error bound, and
+// R's bounds there.
+struct Box {
   double w[3][8][3];
+  double delta;
+  CertifiedRatio ratio;
+  int depth;  // halvings from the root; the next one is along direction depth % 3
+};
+
+// Column c's control values at the vertices: the edges along direction c (twice J's on
+// [-1, 1]^3; R does not depend on W's scale), each within 2u of the largest.
+double element_columns(std::span<const double> x, double (*w)[8][3]) {
   double a = 0;
   for (int c = 0; c < 3; ++c)
     for (int q = 0; q < 8; ++q) {
@@ -125,15 +152,85 @@ CertifiedRatio trilinear_hex_ratio(std::span<const double> x) {
         a = std::max(a, std::abs(e));
       }
     }
-  const double delta = next_up(2 * kUnit * a * kSlack);
-  const double err = next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
-  if (!(err < kMax) || !(a > 0)) return {};
-  // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
-  alignas(64) double m[6][kSlots];
-  for (int x = 0; x < 3; ++x) diagonal_entry(w[x], x, lay, m[x]);
-  for (int e = 0; e < 3; ++e) cross_entry(w, e, lay, m[3 + e]);
-  // The corners are slots 0-7 (vertex q at slot q), as control_matrix_ratio wants them.
-  return control_matrix_ratio(m, kSlots, 8, w, err, delta);
+  return next_up(2 * kUnit * a * kSlack);
+}
+
+// The two halves of `box` along direction d (de Casteljau at 1/2: each column is linear
+// along d). Column d is constant along d and stays; the others' new vertex values are
+// midpoints, each within u|value| of the exact midpoint of the computed ones, which are
+// within delta of the exact ones (a smallest subnormal added for underflow).
+void halve(const Box& box, int d, Box& low, Box& high) {
+  double a = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int q = 0; q < 8; ++q) {
+      const int q0 = q & ~(1 << d), q1 = q | (1 << d);
+      for (int k = 0; k < 3; ++k) {
+        const double v0 = box.w[c][q0][k], v1 = box.w[c][q1][k];
+        const double mid = c == d ? v0 : 0.5 * (v0 + v1);
+        a = std::max(a, std::abs(mid));
+        low.w[c][q][k] = (q & (1 << d)) != 0 ? mid : v0;
+        high.w[c][q][k] = (q & (1 << d)) != 0 ? v1 : mid;
+      }
+    }
+  low.delta = high.delta = next_up((box.delta + kUnit * a) * kSlack + std::numeric_limits<double>::denorm_min());
+  low.depth = high.depth = box.depth + 1;
+}
+
+}  // namespace
+
+CertifiedRatio trilinear_hex_ratio(std::span<const double> x) {
+  QV_ASSERT(x.size() == 24, x.size() << " coordinates for a first-order hexahedron");
+  double w[3][8][3];
+  const double delta = element_columns(x, w);
+  return box_ratio(w, delta);
+}
+
+RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRatio root, double abs_tol,
+                                        int max_halvings) {
+  QV_ASSERT(x.size() == 24, x.size() << " coordinates for a first-order hexahedron");
+  QV_ASSERT(root.ok, "refinement from an uncertified root");
+  const auto settled = [&](double lower, double upper) { return sqrt_up(upper) - sqrt_down(lower) <= abs_tol; };
+  // A lower bound above (sqrt(upper) - 0.9 abs_tol)^2 settles the element.
+  const auto enough = [&](double upper) {
+    const double m = sqrt_rn(upper) - 0.9 * abs_tol;
+    return m <= 0 ? 0.0 : m * m;
+  };
+  // Boxes in a pool (a halved box's slot goes to its first half), a min-heap of their
+  // lower bounds and slots.
+  thread_local std::vector<Box> pool;
+  thread_local std::vector<std::pair<double, int>> heap;
+  const auto later = [](const std::pair<double, int>& p, const std::pair<double, int>& q) { return p > q; };
+  pool.resize(1);
+  pool[0].delta = element_columns(x, pool[0].w);
+  pool[0].ratio = root;
+  pool[0].depth = 0;
+  heap.assign(1, {root.lower, 0});
+  RefinedRatio out;
+  out.ratio = root;
+  while (!settled(heap.front().first, out.ratio.upper)) {
+    if (out.halvings >= max_halvings) break;
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const int slot = heap.back().second;
+    heap.pop_back();
+    const Box top = pool[static_cast<std::size_t>(slot)];
+    pool.emplace_back();
+    const int slots[2] = {slot, static_cast<int>(pool.size() - 1)};
+    halve(top, top.depth % 3, pool[static_cast<std::size_t>(slots[0])], pool.back());
+    ++out.halvings;
+    for (const int s : slots) {
+      Box& child = pool[static_cast<std::size_t>(s)];
+      child.ratio = box_ratio(child.w, child.delta, enough(out.ratio.upper));
+      if (!child.ratio.ok) return {};
+      // The parent's bound holds on its halves too.
+      child.ratio.lower = std::max(child.ratio.lower, top.ratio.lower);
+      out.ratio.upper = std::min(out.ratio.upper, child.ratio.upper);
+      heap.emplace_back(child.ratio.lower, s);
+      std::push_heap(heap.begin(), heap.end(), later);
+    }
+  }
+  out.ratio.lower = heap.front().first;
+  out.settled = settled(out.ratio.lower, out.ratio.upper);
+  return out;
 }
 
 }  // namespace quadval

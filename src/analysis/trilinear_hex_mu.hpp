@@ -28,8 +28,28 @@
 namespace quadval {
 
 /// R's bounds for the hexahedron with these 8 vertices (x, y, z each, Gmsh order), J > 0
-/// proven on it by the caller. Not ok where a control matrix is not certified positive
-/// definite or an eigenvalue step fails (a nearly degenerate element).
+/// proven on it by the caller. Not ok where a vertex's metric is not certified positive
+/// definite or its eigenvalue step fails (a nearly degenerate element); lower is 0 where
+/// another control matrix is not (a distorted element: refinement gives its halves better
+/// ones).
 CertifiedRatio trilinear_hex_ratio(std::span<const double> x);
+
+struct RefinedRatio {
+  CertifiedRatio ratio;  ///< not ok where a box's certification failed
+  int halvings = 0;
+  bool settled = false;  ///< sqrt(upper) - sqrt(lower), rounded outward, is at most abs_tol
+};
+
+/// R's bounds for the same hexahedron refined best first from `root` (its
+/// trilinear_hex_ratio, ok) until mu's are within abs_tol or max_halvings were made: the
+/// box of least lower bound is halved, directions x, y, z in turn. A box of a trilinear map
+/// is trilinear again, so each half is bounded as the element is (its columns' control
+/// values by de Casteljau at 1/2, their rounding added to their error bound). Each half
+/// keeps its parent's lower bound where that is higher; the upper bound is the least over
+/// every box's corners. A half's control matrices are certified only down to what settles
+/// the element (the general path's r_target), most by the cheap test alone. The general
+/// path refines the same way with its own products and one eigen solve per corner.
+RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRatio root, double abs_tol,
+                                        int max_halvings);
 
 }  // namespace quadval

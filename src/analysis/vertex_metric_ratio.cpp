@@ -39,14 +39,16 @@ CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*
 }
 
 CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], int slots, int vertices,
-                                    const double (*w)[8][3], double err, double delta) {
+                                    const double (*w)[8][3], double err, double delta, double enough) {
   using namespace lanes3;
   using L8 = Lanes<8>;
   CertifiedRatio out;
-  // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp). The
-  // vertices' block is enclosed first; a later block only where the cheaper test does not
-  // certify all its lanes at least the least ratio so far, which then stays the bound (a
-  // good element's later blocks mostly pass: hex_box_30 mu 30.3 -> 24.6 ms).
+  // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp), or 0
+  // where one of them is not certified positive definite (control matrices of M need not
+  // be where M is: a distorted element; halves of it have better ones). The vertices'
+  // block is enclosed first; a later block only where the cheaper test does not certify
+  // all its lanes at least the least ratio so far (or `enough`, if less), which then is
+  // the bound (a good element's later blocks mostly pass: hex_box_30 mu 30.3 -> 24.6 ms).
   L8 vertex_m[6];
   for (int e = 0; e < 6; ++e) vertex_m[e] = load_lanes<8>(m[e]);
   const ExtremeEigen<8> vertex_eig = extreme_eigen<8>(vertex_m, broadcast_lanes<8>(err));
@@ -55,9 +57,16 @@ CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], i
   for (int block = 1; block < slots / 8; ++block) {
     L8 mb[6];
     for (int e = 0; e < 6; ++e) mb[e] = load_lanes<8>(&m[e][8 * block]);
-    if (lower > 0 && lower < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, lower)) == 0xffu) continue;
+    const double floor = std::min(lower, enough);
+    if (floor > 0 && floor < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, floor)) == 0xffu) {
+      lower = floor;
+      continue;
+    }
     const ExtremeEigen<8> eig = extreme_eigen<8>(mb, broadcast_lanes<8>(err));
-    if (mask_bits<8>(eig.ok & (eig.lo > 0)) != 0xffu) return out;
+    if (mask_bits<8>(eig.ok & (eig.lo > 0)) != 0xffu) {
+      lower = 0;  // R >= 0 is all that is known
+      break;
+    }
     lower = fold_min(down<8>(eig.lo / eig.hi), lower);
   }
   // Upper: Rayleigh quotients of W at the vertices (lanes 0 to vertices - 1 of block 0).

@@ -74,16 +74,19 @@ VertexProducts vertex_products(int vertices, int points, PairPoint pair_point) {
 }
 
 /// R's bounds from W's control values w[j][q][c] (column j, vertex q, coordinate c), each
-/// within delta of the exact one, every |entry| at most b. Not ok where a control matrix
-/// is not certified positive definite or an eigenvalue step fails.
+/// within delta of the exact one, every |entry| at most b. Not ok where a vertex's metric
+/// is not certified positive definite or its eigenvalue step fails; lower is 0 where
+/// another control matrix is not certified positive definite.
 CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*w)[8][3], double delta, double b);
 
 /// The lane part of vertex_metric_ratio, for callers with their own products
 /// (trilinear_hex_mu.cpp): R's bounds from M's control values m[e][s] (entries m00, m11,
 /// m22, m01, m02, m12; slot s, vertex q's own point at slot q, `slots` a multiple of 8),
-/// each within err of the exact one, and W's vertex values w[j][q][c] within delta.
+/// each within err of the exact one, and W's vertex values w[j][q][c] within delta. A
+/// caller for whom a lower bound of `enough` settles the question gets no higher one where
+/// the cheap test alone proves that.
 CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], int slots, int vertices,
-                                    const double (*w)[8][3], double err, double delta);
+                                    const double (*w)[8][3], double err, double delta, double enough = 1);
 
 /// R's bounds for W = J Jinv (any common scale of J), from J's columns' control values at
 /// the vertices, col[c][q][k], each entry within rounding[c] of the exact one. Where the

@@ -1,7 +1,8 @@
 // The lane kernel of mu for first-order hexahedra (src/analysis/trilinear_hex_mu.hpp):
 // against singular values of W sampled densely and at the corners (Eigen's SVD through the
 // Lagrange basis, mu_test_util.hpp: no code shared with src/analysis/mu_*), the closed form
-// of parallelepipeds, and the general path of mu_bounds on the same elements.
+// of parallelepipeds, and the general path of mu_bounds on the same elements; its
+// refinement (refine_trilinear_hex_ratio) against the same samples and the general path's.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -112,6 +113,79 @@ TEST(TrilinearHexMu, AgreesWithTheGeneralPath) {
   test::check_against_general_path(
       hexahedron8(), [](int e, std::mt19937& r) { return random_hexahedron(e, e % 2 == 0 ? 0.05 : 0.2, r); }, 300,
       100, rng);
+}
+
+// Elements the root does not settle, refined in the kernel (refine_trilinear_hex_ratio)
+// and compared with pointwise R: the lower bound never above a sampled value; the upper
+// bound never below every value of the grid of box corners it can come from (spacing
+// 2^-ceil(h/3) per direction after h halvings in turn); both within tol of each other when
+// settled, and no worse than the root's.
+TEST(TrilinearHexMu, RefinementEnclosesSampledValues) {
+  std::mt19937 rng(41);
+  const ElementType& t = hexahedron8();
+  const LagrangeBasis& basis = lagrange_basis(t);
+  const auto points = test::dense_points(ElementFamily::hexahedron, 10, 200, rng);
+  BoundsWorkspace workspace;
+  int refined = 0, settled = 0, gridded = 0;
+  for (int e = 0; e < 1500; ++e) {
+    const auto x = random_hexahedron(e, e % 2 == 0 ? 0.7 : 0.9, rng);
+    if (jacobian_bounds(t, x, BoundsOptions{}, workspace).validity != Validity::valid) continue;
+    const double tol = e % 3 == 0 ? 1e-3 : 1e-2;
+    const CertifiedRatio root = trilinear_hex_ratio(x);
+    if (!root.ok || std::sqrt(root.upper) - std::sqrt(root.lower) <= tol) continue;
+    ++refined;
+    const RefinedRatio r = refine_trilinear_hex_ratio(x, root, tol, 72);
+    ASSERT_TRUE(r.ratio.ok) << "element " << e;
+    ASSERT_GT(r.halvings, 0);
+    const test::SampledMu sampled = test::sample_mu(basis, x, points);
+    EXPECT_LE(r.ratio.lower, sampled.lo * sampled.lo * (1 + 1e-12)) << "element " << e;
+    EXPECT_GE(r.ratio.lower, root.lower) << "element " << e;
+    EXPECT_LE(r.ratio.upper, root.upper) << "element " << e;
+    if (r.settled) {
+      ++settled;
+      EXPECT_LE(std::sqrt(r.ratio.upper) - std::sqrt(r.ratio.lower), tol * (1 + 1e-9)) << "element " << e;
+    }
+    if (r.halvings <= 9) {
+      ++gridded;
+      const int n = 1 << ((r.halvings + 2) / 3);
+      double grid_min = 1;
+      for (int i = 0; i <= n; ++i)
+        for (int j = 0; j <= n; ++j)
+          for (int k = 0; k <= n; ++k) {
+            const double m = test::pointwise_mu(basis, x, {-1 + 2.0 * i / n, -1 + 2.0 * j / n, -1 + 2.0 * k / n});
+            grid_min = std::min(grid_min, m * m);
+          }
+      EXPECT_GE(r.ratio.upper, grid_min * (1 - 1e-9)) << "element " << e;
+    }
+  }
+  std::printf("[hexahedron refinement] %d refined, %d settled, %d checked on their grid\n", refined, settled, gridded);
+  EXPECT_GE(refined, 100);
+  EXPECT_GE(settled, refined * 95 / 100);
+  EXPECT_GE(gridded, refined / 2);
+}
+
+// mu_bounds refines first-order hexahedra in the kernel (the default) or on the general
+// path (mu_use_constant_path(false)): both meet the tolerance and their intervals overlap.
+TEST(TrilinearHexMu, RefinementAgreesWithTheGeneralPath) {
+  std::mt19937 rng(43);
+  const ElementType& t = hexahedron8();
+  QualityOptions opt;
+  opt.abs_tol = 1e-2;
+  int subdivided = 0, valid = 0;
+  for (int e = 0; e < 1000; ++e) {
+    const auto x = random_hexahedron(e, 0.8, rng);
+    const QualityBounds fast = mu_bounds(t, x, opt, false);
+    mu_use_constant_path(false);
+    const QualityBounds general = mu_bounds(t, x, opt, false);
+    mu_use_constant_path(true);
+    EXPECT_EQ(fast.tolerance_met, general.tolerance_met) << "element " << e;
+    EXPECT_LE(fast.lower, general.upper) << "element " << e;
+    EXPECT_LE(general.lower, fast.upper) << "element " << e;
+    if (fast.upper > 0) ++valid;
+    if (fast.subdivisions > 0 && fast.upper > 0) ++subdivided;
+  }
+  std::printf("[hexahedron refinement] %d valid, %d subdivided\n", valid, subdivided);
+  EXPECT_GE(subdivided, 50);
 }
 
 }  // namespace
