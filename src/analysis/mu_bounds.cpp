@@ -348,11 +348,17 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   QV_ASSERT(!track_metric || m_bisection->size() == space.size(2), "M's space");
   const auto w_block = block;
   const auto slot_size = w_block + (track_metric ? static_cast<std::size_t>(m_vectors * space.size(2)) : 0);
+  long steps = 0;  // bisections (halving) or subdivisions so far
   const auto subdomain_lower = [&](const double* w, double err, double m_err, double r_lo, double r_hi) {
     double lo = r_lo;
     if (mode != 0) {
-      lo = std::max(lo, track_metric ? control_lower_bound_of_metric(space.dim(), w + w_block, m_err, space.size(2))
-                                     : scratch.metric.control_lower_bound(space, w, err));
+      // A subdomain's control matrices are certified only down to what settles the
+      // element (most by the cheap test alone); the root's fully, so that an element
+      // settled there gets the tightest bound.
+      const double enough = steps > 0 ? r_target() : 1.0;
+      lo = std::max(lo, track_metric
+                            ? control_lower_bound_of_metric(space.dim(), w + w_block, m_err, space.size(2), enough)
+                            : scratch.metric.control_lower_bound(space, w, err, enough));
       if (mode == 1 || out.subdivisions < kCertificateAfter || lo >= r_target() ||
           !(std::min(r_hi, 1.0) - lo > tol_r()))
         return lo;
@@ -368,7 +374,6 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // control-matrix gap more slowly: 185 subdivisions instead of 113).
   const long levels = halving ? bisection.levels() : 1;
   const auto children = static_cast<std::size_t>(halving ? 2 : basis.num_children());
-  long steps = 0;
   // A min-heap of subdomains by lower bound, in reused storage (std::priority_queue's own
   // push_heap / pop_heap steps, so the same order).
   std::vector<Subdomain>& heap = scratch.heap;

@@ -305,8 +305,8 @@ double control_ratio_lower2(const double* const* entries, double e, int size) {
   return r;
 }
 
-double control_ratio_lower3(const double* const* entries, double e, int size) {
-  double r = 1;
+double control_ratio_lower3(const double* const* entries, double e, int size, double enough) {
+  double r = std::min(1.0, enough);
   double m[6];
   const auto load = [&](int k) {
     for (int i = 0; i < 6; ++i) m[i] = entries[i][k];
@@ -330,7 +330,10 @@ double control_ratio_lower3(const double* const* entries, double e, int size) {
       const double est = ratio_estimate3(m);
       if (est < least) least = est, first = k;
     }
-    if (first >= 0) enclose(first);
+    if (first >= 0) {
+      load(first);
+      if (!(r < 1 && ratio_at_least3(m, e, r))) enclose(first);
+    }
   }
   // Once a ratio is certified, the cheap test runs on 8 control matrices at once with the
   // r of the block's start; a matrix it certifies is at least that r, so at least the
@@ -365,14 +368,14 @@ double control_ratio_lower3(const double* const* entries, double e, int size) {
 }  // namespace
 
 template <int D>
-double control_ratio_lower(const double* const* entries, const double* err, int size) {
+double control_ratio_lower(const double* const* entries, const double* err, int size, double enough) {
   constexpr int kEntries = D * (D + 1) / 2;
   double e = 0;
   for (int i = 0; i < kEntries; ++i) e = std::max(e, err[i]);
-  return D == 2 ? control_ratio_lower2(entries, e, size) : control_ratio_lower3(entries, e, size);
+  return D == 2 ? control_ratio_lower2(entries, e, size) : control_ratio_lower3(entries, e, size, enough);
 }
 
-template double control_ratio_lower<2>(const double* const*, const double*, int);
-template double control_ratio_lower<3>(const double* const*, const double*, int);
+template double control_ratio_lower<2>(const double* const*, const double*, int, double);
+template double control_ratio_lower<3>(const double* const*, const double*, int, double);
 
 }  // namespace quadval

@@ -91,7 +91,10 @@ double ratio_estimate3(const double* m);
 ///                 order of symmetric_eigen_enclosure (m00, m11, (m22,) m01, ...)
 /// @param err      per entry vector, |exact control value - computed| <= err[i]
 /// @param size     control values per entry (>= 1)
+/// @param enough   3D: a lower bound the caller needs no more than (its r_target); the
+///                 result is at most this, and matrices the cheap test certifies at
+///                 least this are not enclosed (2D encloses every matrix anyway)
 template <int D>
-double control_ratio_lower(const double* const* entries, const double* err, int size);
+double control_ratio_lower(const double* const* entries, const double* err, int size, double enough = 1);
 
 }  // namespace quadval

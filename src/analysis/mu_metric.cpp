@@ -137,7 +137,7 @@ void MuMetric::metric_entries(const MuSpace& space, const double* w, double err)
   }
 }
 
-double MuMetric::control_lower_bound(const MuSpace& space, const double* w, double err) {
+double MuMetric::control_lower_bound(const MuSpace& space, const double* w, double err, double enough) {
   metric_entries(space, w, err);
   const int size = static_cast<int>(m_[0].c.size());
   if (space.dim() == 2) {
@@ -148,7 +148,7 @@ double MuMetric::control_lower_bound(const MuSpace& space, const double* w, doub
   const double* e[6];
   double er[6];
   for (int i = 0; i < 6; ++i) e[i] = m_[i].c.data(), er[i] = m_[i].err;
-  return control_ratio_lower<3>(e, er, size);
+  return control_ratio_lower<3>(e, er, size, enough);
 }
 
 double MuMetric::metric(const MuSpace& space, const double* w, double err, double* out) {
@@ -165,7 +165,7 @@ double MuMetric::metric(const MuSpace& space, const double* w, double err, doubl
   return e;
 }
 
-double control_lower_bound_of_metric(int dim, const double* m, double err, int size) {
+double control_lower_bound_of_metric(int dim, const double* m, double err, int size, double enough) {
   const auto at = [&](int i) { return m + static_cast<std::size_t>(i) * static_cast<std::size_t>(size); };
   if (dim == 2) {
     const double* e[3] = {at(0), at(1), at(2)};
@@ -174,7 +174,7 @@ double control_lower_bound_of_metric(int dim, const double* m, double err, int s
   }
   const double* e[6] = {at(0), at(1), at(2), at(3), at(4), at(5)};
   const double er[6] = {err, err, err, err, err, err};
-  return control_ratio_lower<3>(e, er, size);
+  return control_ratio_lower<3>(e, er, size, enough);
 }
 
 double MuMetric::lower_bound(const MuSpace& space, const double* w, double err, double r_lo,

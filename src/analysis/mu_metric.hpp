@@ -61,8 +61,9 @@ class MuMetric {
 
   /// Certified lower bound of min R over the subdomain from the control matrices of
   /// M = W^T W alone (degree 2n; mu_control_bound.hpp): one product and one small
-  /// eigenvalue enclosure per control matrix. Same parameters as lower_bound.
-  double control_lower_bound(const MuSpace& space, const double* w, double err);
+  /// eigenvalue enclosure per control matrix. Same parameters as lower_bound; `enough`
+  /// as for control_ratio_lower (the result is at most it).
+  double control_lower_bound(const MuSpace& space, const double* w, double err, double enough = 1);
 
   /// The control values of M = W^T W's entries (degree 2n, space.size(2) each), in the
   /// order m00, m11, (m22,) m01, (m02, m12), written to `out` one entry after the other.
@@ -102,7 +103,7 @@ constexpr int metric_vectors(int dim) noexcept { return dim == 2 ? 3 : 6; }
 /// control_lower_bound from M's control values in MuMetric::metric's layout (size values
 /// per entry, all within err of the exact ones): a subdivided subdomain's M comes from its
 /// parent's by the same bisection as W, without products.
-double control_lower_bound_of_metric(int dim, const double* m, double err, int size);
+double control_lower_bound_of_metric(int dim, const double* m, double err, int size, double enough = 1);
 
 /// Certified upper bound of R at the subdomain's corners (the vertex control values of W
 /// are values of W): the Rayleigh quotients of W at approximate eigenvectors of W^T W,

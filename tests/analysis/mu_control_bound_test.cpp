@@ -276,7 +276,8 @@ TEST(MuControlBound, ControlRatioAgainstExactKroneckerCriterion) {
   // every matrix of the set must satisfy lambda_min > r lambda_max exactly, also at the
   // corners of the error box. Shapes: nearly isotropic, one large and two equal
   // eigenvalues (where the eigenvalue-free test is sharp), two equal large ones (where it
-  // is loose and the enclosure must take over), and spread ones.
+  // is loose and the enclosure must take over), and spread ones. The same with a bound
+  // that suffices (`enough`) below and above the least ratio.
   std::mt19937 rng(17);
   std::uniform_real_distribution<double> u(-1, 1);
   const std::array<std::array<double, 3>, 4> shapes = {{{1, 0.97, 0.95}, {1, 0.6, 0.6}, {1, 1, 0.5}, {1, 0.5, 0.2}}};
@@ -300,7 +301,14 @@ TEST(MuControlBound, ControlRatioAgainstExactKroneckerCriterion) {
     const double* e[6];
     for (int i = 0; i < 6; ++i) e[i] = entries[static_cast<std::size_t>(i)].data();
     const double errs[6] = {err, err, err, err, err, err};
-    const double r = control_ratio_lower<3>(e, errs, 27);
+    // With enough (what settles the caller) below the least ratio, that is the bound; above
+    // it, the bound stays tight.
+    const double below = 0.9 * least, above = std::min(1.1 * least, 0.999);
+    EXPECT_EQ(control_ratio_lower<3>(e, errs, 27, below), below);
+    const double r_above = control_ratio_lower<3>(e, errs, 27, above);
+    EXPECT_LE(r_above, above);
+    EXPECT_GT(r_above, least * (1 - 1e-6));
+    const double r = std::max(control_ratio_lower<3>(e, errs, 27), r_above);  // the stronger claim checked below
     SCOPED_TRACE(trial);
     EXPECT_GT(r, least * (1 - 1e-6));  // tight (the rotation's rounding moves l by ~1e-16)
     for (const auto& m : ms)
