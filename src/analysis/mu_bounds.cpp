@@ -53,7 +53,6 @@ struct MuScratch {
   MuMetric metric;
   std::vector<double> pool;
   std::vector<int> free_slots;
-  std::vector<double> sub_scratch;
   std::vector<std::array<double, 9>> corners;  // W at the corners bounded in this split
   std::vector<double> children;                // the children of the subdomain refined
   std::vector<Subdomain> heap;
@@ -334,13 +333,16 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // Types above mu_certificate_max_order have no certificate (mu_space.hpp): the control
   // bound alone, whatever mode was asked for.
   const int mode = space.has_certificate() ? control_mode : 1;
-  // Halving (not tetrahedra) with the control bound: each subdomain's slot also holds M's
-  // control values, halved with W's (the same bisection sequence: M's space has W's
-  // factors at twice the degree), so that a child's control bound needs no product.
-  // Tetrahedra recompute M from their 8 children's W: subdividing M with the dense
-  // matrices of its degree-2n space cost more (warped_tetrahedron_o3: 6% slower).
-  const bool halving = type.family != ElementFamily::tetrahedron;
-  const bool track_metric = halving && mode != 0;
+  // Tetrahedra: twice as many, as a bisection of a tetrahedron closes the control bound's
+  // gap more slowly (tets_h0.8_o2's element 2186: settled by the control bound at 34
+  // subdivisions, 210 us, and with the certificate from 24 at 27, 220 us, whose tables
+  // then cost 1 ms to build in each process).
+  const int certificate_after =
+      type.family == ElementFamily::tetrahedron ? 2 * kCertificateAfter : kCertificateAfter;
+  // With the control bound each subdomain's slot also holds M's control values, halved
+  // with W's (the same bisection sequence: M's space has W's factors at twice the
+  // degree), so that a child's control bound needs no product.
+  const bool track_metric = mode != 0;
   const BernsteinBisection& bisection = space.bisection(1);
   const BernsteinBisection* m_bisection = track_metric ? &space.bisection(2) : nullptr;
   const int vectors = space.dim() * 3;
@@ -348,7 +350,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   QV_ASSERT(!track_metric || m_bisection->size() == space.size(2), "M's space");
   const auto w_block = block;
   const auto slot_size = w_block + (track_metric ? static_cast<std::size_t>(m_vectors * space.size(2)) : 0);
-  long steps = 0;  // bisections (halving) or subdivisions so far
+  long steps = 0;  // bisections so far
   const auto subdomain_lower = [&](const double* w, double err, double m_err, double r_lo, double r_hi) {
     double lo = r_lo;
     if (mode != 0) {
@@ -359,21 +361,23 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       lo = std::max(lo, track_metric
                             ? control_lower_bound_of_metric(space.dim(), w + w_block, m_err, space.size(2), enough)
                             : scratch.metric.control_lower_bound(space, w, err, enough));
-      if (mode == 1 || out.subdivisions < kCertificateAfter || lo >= r_target() ||
+      if (mode == 1 || out.subdivisions < certificate_after || lo >= r_target() ||
           !(std::min(r_hi, 1.0) - lo > tol_r()))
         return lo;
     }
     return scratch.metric.lower_bound(space, w, err, lo, r_hi, r_target(), tol_r());
   };
   // Refinement: the subdomain with the least bound is halved by one bisection of W's
-  // space (BernsteinBisection::halve, `levels` halvings counting as one subdivision),
-  // except tetrahedra, which get BezierBasis's 8 midpoint children. Measured against the
-  // midpoint children, --tol 1e-2, one thread (medians of 5): hex_box 0.23 -> 0.17 s,
-  // warped_prism 28 -> 22 ms, warped_pyramid_o2 74 -> 64 ms, the 2D meshes within noise;
-  // but tets_h0.8_o2 42 -> 71 ms (Maubach's children of a tetrahedron close the
-  // control-matrix gap more slowly: 185 subdivisions instead of 113).
-  const long levels = halving ? bisection.levels() : 1;
-  const auto children = static_cast<std::size_t>(halving ? 2 : basis.num_children());
+  // space (BernsteinBisection::halve, `levels` halvings counting as one subdivision).
+  // Measured against the 8 midpoint children of BezierBasis, --tol 1e-2, one thread
+  // (medians of 5): hex_box 0.23 -> 0.17 s, warped_prism 28 -> 22 ms, warped_pyramid_o2
+  // 74 -> 64 ms, the 2D meshes within noise. Tetrahedra kept the midpoint children until
+  // their subdomains' control matrices were certified only down to r_target (Maubach's
+  // children close the gap more slowly: tets_h0.8_o2 then took 42 -> 71 ms); since, mu on
+  // 2 threads, medians of 11 alternating CLI runs: warped_tetrahedron_o3 8.1 -> 5.0 ms,
+  // mixed_h0.6_o2 and tets_h0.8_o2 within noise once the certificate waits longer for
+  // tetrahedra (below).
+  const long levels = bisection.levels();
   // A min-heap of subdomains by lower bound, in reused storage (std::priority_queue's own
   // push_heap / pop_heap steps, so the same order).
   std::vector<Subdomain>& heap = scratch.heap;
@@ -389,8 +393,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   }
   push({subdomain_lower(pool.data(), err0, m_err0, 0, r_upper), err0, m_err0, 0, bisection.root_state()});
   int next_slot = 1;
-  scratch.children.resize(children * slot_size);
-  scratch.sub_scratch.resize(2 * static_cast<std::size_t>(basis.size()));
+  scratch.children.resize(2 * slot_size);
   while (true) {
     const Subdomain top = heap.front();
     out.lower = sqrt_down(top.lower);
@@ -406,38 +409,28 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
     out.subdivisions = static_cast<int>((steps + levels - 1) / levels);
     const auto par = static_cast<std::size_t>(top.slot) * slot_size;
     const double wmax = largest_magnitude(pool.data() + par, block);
-    // Averages (halving) and rows of exact nonnegative weights summing to 1 (midpoint
-    // children) never exceed their inputs: the parent's error plus the step's rounding.
+    // Averages never exceed their inputs: the parent's error plus the step's rounding.
     const double child_err =
-        (top.err + (halving ? bisection.halving_rounding_relative() * wmax + bisection.halving_rounding_absolute()
-                            : basis.subdivision_rounding() * wmax)) *
-        (1 + 1e-12);
+        (top.err + bisection.halving_rounding_relative() * wmax + bisection.halving_rounding_absolute()) * (1 + 1e-12);
     // The parent's corners are in r_upper already, bounded with a smaller error bound.
     scratch.corners.clear();
     remember_corners(space, pool.data() + par, scratch.corners);
     BisectionState states[2];
     double child_m_err = 0;
-    if (halving) {
-      double* first = scratch.children.data();
-      double* second = first + slot_size;
-      bisection.halve(pool.data() + par, static_cast<std::size_t>(vectors), top.state, first, second, states);
-      if (track_metric) {
-        const double* m = pool.data() + par + w_block;
-        const auto m_size = slot_size - w_block;
-        child_m_err = (top.m_err + m_bisection->halving_rounding_relative() * largest_magnitude(m, m_size) +
-                       m_bisection->halving_rounding_absolute()) *
-                      (1 + 1e-12);
-        BisectionState unused[2];
-        m_bisection->halve(m, static_cast<std::size_t>(m_vectors), top.state, first + w_block, second + w_block, unused);
-      }
-    } else {
-      // All vectors at once: each child's matrix is read once (bit-identical to one by one).
-      for (std::size_t q = 0; q < children; ++q)
-        basis.subdivide_many(static_cast<int>(q), pool.data() + par, static_cast<std::size_t>(vectors),
-                             scratch.children.data() + q * slot_size, scratch.sub_scratch.data());
+    double* first = scratch.children.data();
+    double* second = first + slot_size;
+    bisection.halve(pool.data() + par, static_cast<std::size_t>(vectors), top.state, first, second, states);
+    if (track_metric) {
+      const double* m = pool.data() + par + w_block;
+      const auto m_size = slot_size - w_block;
+      child_m_err = (top.m_err + m_bisection->halving_rounding_relative() * largest_magnitude(m, m_size) +
+                     m_bisection->halving_rounding_absolute()) *
+                    (1 + 1e-12);
+      BisectionState unused[2];
+      m_bisection->halve(m, static_cast<std::size_t>(m_vectors), top.state, first + w_block, second + w_block, unused);
     }
     free_slots.push_back(top.slot);
-    for (std::size_t q = 0; q < children; ++q) {
+    for (std::size_t q = 0; q < 2; ++q) {
       int slot;
       if (!free_slots.empty()) {
         slot = free_slots.back();
@@ -453,7 +446,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
       const double corner = corner_ratio_upper(space, pool.data() + child, child_err, &scratch.corners, r_upper);
       r_upper = std::min(r_upper, corner);
       const double lo = subdomain_lower(pool.data() + child, child_err, child_m_err, top.lower, std::min(corner, r_upper));
-      push({lo, child_err, child_m_err, slot, halving ? states[q] : top.state});
+      push({lo, child_err, child_m_err, slot, states[q]});
     }
   }
   return out;
