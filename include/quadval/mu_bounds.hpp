@@ -43,8 +43,10 @@
 ///   R >= min_k lambda_min(M_k) / lambda_max(M_k), each ratio from a certified eigenvalue
 ///   enclosure (closed form 2x2; 3x3: trigonometric approximation certified by Sylvester's
 ///   criterion, else Gershgorin at approximate eigenvectors with Ostrowski's theorem). It
-///   converges quadratically under subdivision and settles almost every subdomain. Only in
-///   an element split 24 times already (types with the certificate only: order <=
+///   converges quadratically under subdivision and settles almost every subdomain. A
+///   subdomain's control matrices are certified only down to what settles the element.
+///   Only in an element split 24 times already (48 for tetrahedra; types with the
+///   certificate only: order <=
 ///   mu_certificate_max_order), and where that bound falls short, the exact
 ///   certificate: the largest r (bisection) with R >= r, R = mu_pw^2:
 ///   2D (Paper V §4): a^2 = q^2 / (s^2 + t^2) >= rho from the control values (§3.1), then
@@ -81,9 +83,12 @@
 ///   points with t > 0 are dense. Every bound above is a bound of that minimum; the corner
 ///   values on t = 0 used by `upper` are limits of values inside the element, hence still
 ///   upper bounds of the infimum. A limit J <= 0 on t = 0 counts as J <= 0 (mu = 0).
-/// Refinement is best-first (the subdomain with the smallest lower bound is split into its
-/// 2^dim children) until upper - lower <= abs_tol or max_subdivisions subdomains were
-/// split; tolerance_met says which.
+/// Refinement is best-first (the subdomain with the smallest lower bound is halved by one
+/// bisection, src/bezier/bernstein_bisection.hpp; dim bisections count as one
+/// subdivision) until upper - lower <= abs_tol or max_subdivisions subdivisions were
+/// made; tolerance_met says which. A first-order hexahedron is refined the same way in its
+/// own kernel (src/analysis/trilinear_hex_mu.hpp), the general path taking over where that
+/// fails.
 
 #include <span>
 
