@@ -322,8 +322,10 @@ double control_ratio_lower3(const double* const* entries, double e, int size, do
   // The matrix of least estimated ratio is enclosed first, so that the cheap test below
   // certifies most others against an r near the final one (hex_box: 4.8 enclosures per
   // subdomain when starting from the first matrix).
+  // With a bound that suffices below 1 (a subdomain's r_target), most matrices pass the
+  // cheap test against it at once, and the search is skipped.
   int first = -1;
-  if (size > 1) {
+  if (size > 1 && enough >= 1) {
     double least = kInf;
     for (int k = 0; k < size; ++k) {
       load(k);
@@ -353,7 +355,10 @@ double control_ratio_lower3(const double* const* entries, double e, int size, do
       block_r = r;
       Lanes<8> lanes[6];
       for (int i = 0; i < 6; ++i)
-        for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
+        if (block_end - k == 8)
+          lanes[i] = load_lanes<8>(entries[i] + k);
+        else
+          for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
       certified = ratio_at_least3_lanes(lanes, e, r);
     }
     if (k < block_end && ((certified >> (k - block_start)) & 1u) != 0) continue;
