@@ -374,9 +374,9 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   // 74 -> 64 ms, the 2D meshes within noise. Tetrahedra kept the midpoint children until
   // their subdomains' control matrices were certified only down to r_target (Maubach's
   // children close the gap more slowly: tets_h0.8_o2 then took 42 -> 71 ms); since, mu on
-  // 2 threads, medians of 11 alternating CLI runs: warped_tetrahedron_o3 8.1 -> 5.0 ms,
-  // mixed_h0.6_o2 and tets_h0.8_o2 within noise once the certificate waits longer for
-  // tetrahedra (below).
+  // 2 threads, medians of 11 alternating CLI runs (two runs): warped_tetrahedron_o3
+  // 8.1-8.4 -> 5.0-5.5 ms, mixed_h0.6_o2 within noise, tets_h0.8_o2 3.89 -> 3.65 ms once
+  // the certificate waits longer for tetrahedra (above).
   const long levels = bisection.levels();
   // A min-heap of subdomains by lower bound, in reused storage (std::priority_queue's own
   // push_heap / pop_heap steps, so the same order).
