@@ -73,20 +73,48 @@ inline void check_against_samples(const ElementType& t, const RatioKernel& kerne
   EXPECT_GE(settled, valid / 2);
 }
 
-/// mu_bounds with the kernel (the default) and with the general path alone
-/// (mu_use_constant_path(false)) on `count` elements: overlapping intervals, and the same
-/// bounds to 1e-10 where both settle at the root, at least `min_root` times.
+/// mu_bounds of one element with the kernels (the default) and with the general path alone
+/// (mu_use_constant_path(false)).
+struct BothPaths {
+  QualityBounds fast, general;
+};
+inline BothPaths mu_both_paths(const ElementType& t, const std::vector<double>& x, const QualityOptions& opt) {
+  BothPaths out;
+  out.fast = mu_bounds(t, x, opt, false);
+  mu_use_constant_path(false);
+  out.general = mu_bounds(t, x, opt, false);
+  mu_use_constant_path(true);
+  return out;
+}
+
+/// Where W is constant, R is its value at any point: the kernel's bounds of a valid
+/// element enclose pointwise R at `p` and equal it to 1e-8. False where the element is
+/// not proven valid (not checked).
+inline bool check_constant_ratio(const ElementType& t, const std::vector<double>& x, const RatioKernel& kernel,
+                                 const RefPoint& p, int e) {
+  BoundsOptions bo;
+  BoundsWorkspace ws;
+  if (jacobian_bounds(t, x, bo, ws).validity != Validity::valid) return false;
+  const CertifiedRatio r = kernel(x);
+  EXPECT_TRUE(r.ok) << "element " << e;
+  if (!r.ok) return true;
+  const double mu = pointwise_mu(lagrange_basis(t), x, p);
+  EXPECT_LE(r.lower, mu * mu * (1 + 1e-12)) << "element " << e;
+  EXPECT_GE(r.upper, mu * mu * (1 - 1e-12)) << "element " << e;
+  EXPECT_NEAR(r.lower, mu * mu, 1e-8) << "element " << e;
+  EXPECT_NEAR(r.upper, mu * mu, 1e-8) << "element " << e;
+  return true;
+}
+
+/// mu_both_paths on `count` elements: overlapping intervals, and the same bounds to 1e-10
+/// where both settle at the root, at least `min_root` times.
 inline void check_against_general_path(const ElementType& t, const MakeElement& make, int count, int min_root,
                                        std::mt19937& rng) {
   QualityOptions opt;
   opt.abs_tol = 1e-2;
   int root = 0;
   for (int e = 0; e < count; ++e) {
-    const auto x = make(e, rng);
-    const QualityBounds fast = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(false);
-    const QualityBounds general = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(true);
+    const auto [fast, general] = mu_both_paths(t, make(e, rng), opt);
     EXPECT_LE(fast.lower, general.upper) << "element " << e;
     EXPECT_LE(general.lower, fast.upper) << "element " << e;
     if (fast.subdivisions == 0 && general.subdivisions == 0 && fast.upper > 0) {

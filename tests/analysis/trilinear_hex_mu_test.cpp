@@ -173,11 +173,7 @@ TEST(TrilinearHexMu, RefinementAgreesWithTheGeneralPath) {
   opt.abs_tol = 1e-2;
   int subdivided = 0, valid = 0;
   for (int e = 0; e < 1000; ++e) {
-    const auto x = random_hexahedron(e, 0.8, rng);
-    const QualityBounds fast = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(false);
-    const QualityBounds general = mu_bounds(t, x, opt, false);
-    mu_use_constant_path(true);
+    const auto [fast, general] = test::mu_both_paths(t, random_hexahedron(e, 0.8, rng), opt);
     EXPECT_EQ(fast.tolerance_met, general.tolerance_met) << "element " << e;
     EXPECT_LE(fast.lower, general.upper) << "element " << e;
     EXPECT_LE(general.lower, fast.upper) << "element " << e;
