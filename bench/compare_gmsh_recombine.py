@@ -26,7 +26,9 @@ other jobs share the machine.
         --cases rect-sin-a6 uniform-10k-a6 square-hole-35k
 
 Cases: rect-sin-a6 (../shared/data/tri/rect-sin.geo), uniform-N-a6 (unit square, uniform size,
-about N triangles; N = 10k reproduces uniform-10k-a6.msh's 10,076), square-hole-N (Paper I
+about N triangles; N = 10k reproduces uniform-10k-a6.msh's 10,076), uniform-N-a5 (the same
+square triangulated by Gmsh's Delaunay, Mesh.Algorithm 5: fewer equilateral triangles, so
+fewer equal costs; see blossom_solver.hpp for why those matter), square-hole-N (Paper I
 section 8.1: the construction of scripts/lookahead_square_hole.py, rebuilt here because Gmsh
 needs the geometry). Triangle meshes are cached under /tmp/quadval_recombine_bench/.
 """
@@ -144,9 +146,11 @@ def build_rect_sin():
     gmsh.open(os.path.join(SHARED, "rect-sin.geo"))
 
 
-def build_uniform(triangles):
-    """Unit square, uniform size: about 2.3 / h^2 triangles for Frontal-Delaunay."""
-    h = (2.3 / triangles) ** 0.5
+def build_uniform(triangles, algorithm=6):
+    """Unit square, uniform size: about 2.3 / h^2 triangles for Frontal-Delaunay (6); with
+    Delaunay (5), about 2.65 / h^2."""
+    h = ((2.3 if algorithm == 6 else 2.65) / triangles) ** 0.5
+    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
     gmsh.model.add("square")
     gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
     gmsh.model.occ.synchronize()
@@ -186,8 +190,8 @@ def triangulate(build):
     gmsh.clear()
     for name, value in (("Mesh.MeshSizeMin", 0), ("Mesh.MeshSizeMax", 1e22)):
         gmsh.option.setNumber(name, value)
-    build()
     gmsh.option.setNumber("Mesh.Algorithm", 6)
+    build()  # may choose another algorithm
     gmsh.option.setNumber("Mesh.RecombinationAlgorithm", 1)
     t0 = time.perf_counter()
     gmsh.option.setNumber("Mesh.RecombineAll", 1)  # curves get parity-preserving node counts
@@ -218,12 +222,15 @@ def parse_count(text):
 def case_builder(name):
     if name == "rect-sin-a6":
         return build_rect_sin
-    if name.startswith("uniform-") and name.endswith("-a6"):
-        n = parse_count(name[len("uniform-"):-len("-a6")])
-        return lambda: build_uniform(n)
+    for algorithm in (5, 6):
+        suffix = f"-a{algorithm}"
+        if name.startswith("uniform-") and name.endswith(suffix):
+            n = parse_count(name[len("uniform-"):-len(suffix)])
+            return lambda: build_uniform(n, algorithm)
     if name.startswith("square-hole-"):
         return square_hole_builder(parse_count(name[len("square-hole-"):]))
-    sys.exit(f"unknown case {name!r}: rect-sin-a6, uniform-N-a6, square-hole-N (N like 35k)")
+    sys.exit(f"unknown case {name!r}: rect-sin-a6, uniform-N-a6, uniform-N-a5, square-hole-N "
+             "(N like 35k)")
 
 
 def triangle_mesh(name, build):

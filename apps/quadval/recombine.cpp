@@ -80,6 +80,7 @@ nlohmann::json stats_json(const RecombineStats& s) {
       {"edge_swaps", s.edge_swaps},             {"vertex_duplications", s.vertex_duplications},
       {"total_cost", s.matching_cost},          {"smoothing_moves", s.smoothing_moves},
       {"vertex_merges", s.vertex_merges},       {"doublet_collapses", s.doublet_collapses},
+      {"diagonal_swaps", s.diagonal_swaps},
       {"quads", s.quads},                       {"triangles_left", s.triangles},
       {"nodes", s.nodes},                       {"invalid_quads", s.invalid_quads},
       {"eta_min", s.eta_min},                   {"eta_mean", s.eta_mean},
@@ -246,7 +247,7 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--cleanup-passes", o->cleanup_passes,
-                  "Rounds of quad-vertex-merge and doublet collapse (0: none)")
+                  "Rounds of quad-vertex-merge, doublet collapse and diagonal swaps of invalid quads (0: none)")
       ->capture_default_str();
   cmd->add_flag("--no-optimize", o->no_optimize, "No smoothing and no clean-up (Paper I §6)");
   cmd->add_flag("--full-quad", o->full_quad,

@@ -60,7 +60,12 @@
 //   instead of 3.7 s. But that solve took 12 s (LEMON's CostScaling: 1.7 s on uniform-10k,
 //   where this solver takes 0.05 s), and near-optimal duals do not do: lowering each exact
 //   dual by a random amount below 1e-4 cost units made the solver take 19 s, as it breaks
-//   the tight structure everywhere. An auction with epsilon-scaling (Bertsekas) for those
+//   the tight structure everywhere. The cover solved by this solver itself (bipartite: no
+//   blossoms; started from this graph's greedy start on both copies) took 5.2 s, 15.4M grows
+//   for 1,384 augmentations: the relaxation has the same regrowth of tight regions (few odd
+//   cycles survive in its optimum, so its free vertices pair up across the mesh as well);
+//   from its duals and half-integral matching (odd cycles matched around, one vertex left
+//   free) this solver then needed 0.15 s and 4 augmentations. An auction with epsilon-scaling (Bertsekas) for those
 //   duals fell into price wars: over 100 bids per vertex per phase on uniform-10k. With
 //   global price updates (every n bids, prices raised by a bucketed shortest-path pass from
 //   the unassigned vertices), assignments kept across phases while still epsilon-optimal,

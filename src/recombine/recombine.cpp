@@ -111,9 +111,10 @@ void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& op
   smoothing.slides = &slides_after;
   stats.vertex_merges += c.vertex_merges;
   stats.doublet_collapses += c.doublet_collapses;
-  timer.stage("cleanup", fmt::format("{} quad-vertex-merges, {} doublet collapses",
-                                     c.vertex_merges, c.doublet_collapses));
-  if (c.vertex_merges + c.doublet_collapses > 0) {
+  stats.diagonal_swaps += c.diagonal_swaps;
+  timer.stage("cleanup", fmt::format("{} quad-vertex-merges, {} doublet collapses, {} diagonal swaps",
+                                     c.vertex_merges, c.doublet_collapses, c.diagonal_swaps));
+  if (c.vertex_merges + c.doublet_collapses + c.diagonal_swaps > 0) {
     const std::size_t moves = smooth(m, fixed, smoothing);
     stats.smoothing_moves += moves;
     timer.stage("smooth", fmt::format("{} moves after clean-up", moves));

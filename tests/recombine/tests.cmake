@@ -4,6 +4,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   recombine/blossom_solver_test.cpp
   recombine/boundary_slide_test.cpp
   recombine/smoothing_test.cpp
+  recombine/quad_cleanup_test.cpp
   recombine/node_order_test.cpp
   recombine/recombine_test.cpp
   recombine/repair_test.cpp

@@ -1,0 +1,119 @@
+// The diagonal swap of the clean-up: a quad with a flat corner at a boundary node, which no
+// smoothing can open, is re-split with its neighbour.
+#include <algorithm>
+#include <set>
+#include <utility>
+
+#include <gtest/gtest.h>
+
+#include "quadval/recombine.hpp"
+#include "recombine/mixed_mesh.hpp"
+#include "recombine/quad_cleanup.hpp"
+#include "recombine/quad_mesh_checks.hpp"
+#include "recombine/smoothing.hpp"
+#include "recombine/test_meshes.hpp"
+
+namespace quadval {
+namespace {
+
+using recombine_detail::MixedMesh;
+
+// Nodes a, b, c on the straight side y = 0 (b only in triangles t0 and t1), x, e, f above:
+// t0 = (a, b, x) has no other neighbour than t1 = (b, c, x), and t3 = (x, e, f) none other than
+// t2 = (x, c, e), so the only perfect matching (without extra edges, whose cost is far above)
+// pairs t0-t1 and t2-t3: the quad (a, b, c, x) has a flat corner at b.
+const std::vector<std::array<double, 2>> kNodes = {{0, 0}, {1, 0}, {2, 0}, {0.8, 1.2}, {2.5, 0.8}, {2, 1.8}};
+enum : NodeIndex { A, B, C, X, E, F };
+
+TEST(QuadCleanup, FlatBoundaryCornerIsMendedByADiagonalSwap) {
+  const Mesh in = test::make_triangle_mesh(kNodes, {{A, B, X}, {B, C, X}, {X, C, E}, {X, E, F}});
+  RecombineOptions no_cleanup;
+  no_cleanup.max_cleanup_passes = 0;
+  const RecombineResult before = recombine(in, no_cleanup);
+  EXPECT_EQ(before.stats.quads, 2u);
+  EXPECT_EQ(before.stats.invalid_quads, 1u) << "the flat corner at b";
+  EXPECT_EQ(before.stats.eta_min, 0.0);
+
+  const RecombineResult r = recombine(in, {});
+  EXPECT_EQ(r.stats.diagonal_swaps, 1u);
+  EXPECT_EQ(r.stats.invalid_quads, 0u);
+  EXPECT_GT(r.stats.eta_min, 0.3);
+  const test::QuadMeshSummary s = test::expect_valid_recombination(in, r.mesh);
+  EXPECT_EQ(s.quads, 2u);
+  EXPECT_EQ(s.triangles, 0u);
+  // The hexagon's other valid split, by hand: along b-f, (b, c, e, f) and (f, x, a, b).
+  std::set<std::set<Tag>> quads;
+  for (const ElementBlock& b : r.mesh.blocks)
+    for (std::size_t e = 0; e < b.size(); ++e) {
+      std::set<Tag> q;
+      for (NodeIndex v : b.element(e)) q.insert(r.mesh.node_tags[v]);
+      quads.insert(q);
+    }
+  const auto tag = [](NodeIndex v) { return static_cast<Tag>(v + 1); };  // make_triangle_mesh tags
+  EXPECT_EQ(quads, (std::set<std::set<Tag>>{{tag(B), tag(C), tag(E), tag(F)}, {tag(F), tag(X), tag(A), tag(B)}}));
+}
+
+MixedMesh two_quads(const std::vector<std::array<double, 2>>& xy, const std::array<NodeIndex, 4>& q0,
+                    const std::array<NodeIndex, 4>& q1) {
+  MixedMesh m;
+  for (std::size_t i = 0; i < xy.size(); ++i) m.add_node({xy[i][0], xy[i][1], 0.0}, static_cast<Tag>(i + 1));
+  for (const auto& q : {q0, q1}) {
+    m.elements.push_back(q);
+    m.region.push_back(0);
+    m.normal.push_back({0, 0, 1});
+    m.alive.push_back(1);
+  }
+  return m;
+}
+
+TEST(QuadCleanup, SwapNeedsASplitWithoutStuckCorners) {
+  // Here c's other neighbour d is on the side too: both other splits of the hexagon
+  // (a, b, c, d, y, x) keep a flat corner at a fixed node (b or c), so nothing changes.
+  const std::vector<std::array<double, 2>> xy = {{0, 0}, {1, 0}, {2, 0}, {1, 1}, {3, 0}, {2.5, 1}};
+  enum : NodeIndex { a, b, c, x, d, y };
+  MixedMesh m = two_quads(xy, {a, b, c, x}, {x, c, d, y});
+  const std::vector<char> fixed = {1, 1, 1, 0, 1, 0};
+  const auto elements = m.elements;
+  EXPECT_EQ(recombine_detail::element_score(m, 0), 0.0);
+  EXPECT_GT(recombine_detail::element_score(m, 1), 0.0);
+  EXPECT_EQ(recombine_detail::cleanup_quads(m, fixed, 5).diagonal_swaps, 0u);
+  EXPECT_EQ(m.elements, elements);
+
+  // The same two quads with f above the side: swapped, nodes unmoved, outline kept.
+  MixedMesh m2 = two_quads(kNodes, {A, B, C, X}, {X, C, E, F});
+  const auto coords = m2.coords;
+  EXPECT_EQ(recombine_detail::cleanup_quads(m2, {1, 1, 1, 0, 0, 0}, 5).diagonal_swaps, 1u);
+  EXPECT_EQ(m2.coords, coords);
+  for (std::size_t e = 0; e < 2; ++e) EXPECT_GT(recombine_detail::element_score(m2, e), 0.0) << e;
+  std::multiset<std::pair<NodeIndex, NodeIndex>> edges;  // directed, counter-clockwise
+  for (const auto& q : m2.elements)
+    for (int k = 0; k < 4; ++k) edges.insert({q[k], q[(k + 1) % 4]});
+  for (const auto& [from, to] : std::vector<std::pair<NodeIndex, NodeIndex>>{{A, B}, {B, C}, {C, E}, {E, F}, {F, X}, {X, A}})
+    EXPECT_EQ(edges.count({from, to}), 1u) << "outline edge " << from << "-" << to;
+
+  // With x lower, the split along b-f is the one without a stuck corner, but (f, x, a, b) is
+  // reflex at x: swapped all the same (b's corner cannot open, x's can), and the pipeline's
+  // smoothing and polish then open it (x, in one quad only, is smoothed onto the line f-a:
+  // the polish's search takes it off).
+  std::vector<std::array<double, 2>> low = kNodes;
+  low[X] = {1.2, 0.7};
+  MixedMesh m4 = two_quads(low, {A, B, C, X}, {X, C, E, F});
+  const std::vector<char> fixed4 = {1, 1, 1, 0, 1, 1};
+  EXPECT_GT(recombine_detail::element_score(m4, 1), 0.0);
+  EXPECT_EQ(recombine_detail::cleanup_quads(m4, fixed4, 5).diagonal_swaps, 1u);
+  double worst = 1;
+  for (std::size_t e = 0; e < 2; ++e) worst = std::min(worst, recombine_detail::element_score(m4, e));
+  EXPECT_LT(worst, 0.0);
+  recombine_detail::smooth(m4, fixed4, {});
+  recombine_detail::polish_worst(m4, fixed4, {});
+  for (std::size_t e = 0; e < 2; ++e) EXPECT_GT(recombine_detail::element_score(m4, e), 0.0) << e;
+
+  // Valid quads are never swapped.
+  MixedMesh m3 = two_quads(kNodes, {B, C, E, F}, {F, X, A, B});
+  const auto valid = m3.elements;
+  EXPECT_EQ(recombine_detail::cleanup_quads(m3, {1, 1, 1, 0, 0, 0}, 5).diagonal_swaps, 0u);
+  EXPECT_EQ(m3.elements, valid);
+}
+
+}  // namespace
+}  // namespace quadval
