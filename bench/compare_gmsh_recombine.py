@@ -28,12 +28,14 @@ other jobs share the machine.
 Cases: rect-sin-a6 (../shared/data/tri/rect-sin.geo), uniform-N-a6 (unit square, uniform size,
 about N triangles; N = 10k reproduces uniform-10k-a6.msh's 10,076), uniform-N-a5 (the same
 square triangulated by Gmsh's Delaunay, Mesh.Algorithm 5: fewer equilateral triangles, so
-fewer equal costs; see blossom_solver.hpp for why those matter), square-hole-N (Paper I
+fewer equal costs; see blossom_solver.hpp for why those matter), disk-N-a5 / disk-N-a6 (a
+disk of diameter 1, about N triangles, Delaunay or Frontal-Delaunay), square-hole-N (Paper I
 section 8.1: the construction of scripts/lookahead_square_hole.py, rebuilt here because Gmsh
 needs the geometry). Triangle meshes are cached under /tmp/quadval_recombine_bench/.
 """
 import argparse
 import json
+import math
 import os
 import statistics
 import subprocess
@@ -158,6 +160,17 @@ def build_uniform(triangles, algorithm=6):
     gmsh.option.setNumber("Mesh.MeshSizeMax", h)
 
 
+def build_disk(triangles, algorithm):
+    """Unit-diameter disk, uniform size, Gmsh's Delaunay (5) or Frontal-Delaunay (6)."""
+    h = ((2.5 * math.pi / 4) / triangles) ** 0.5
+    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+    gmsh.model.add("disk")
+    gmsh.model.occ.addDisk(0.5, 0.5, 0, 0.5, 0.5)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+
+
 def build_square_hole(h_min):
     """Paper I section 8.1: unit square minus the disk of radius 0.15 at (0.75, 0.75),
     h = h_min + 4 h_min min(d / 0.3, 1) with d the distance to the boundary (the same
@@ -227,10 +240,13 @@ def case_builder(name):
         if name.startswith("uniform-") and name.endswith(suffix):
             n = parse_count(name[len("uniform-"):-len(suffix)])
             return lambda: build_uniform(n, algorithm)
+        if name.startswith("disk-") and name.endswith(suffix):
+            n = parse_count(name[len("disk-"):-len(suffix)])
+            return lambda: build_disk(n, algorithm)
     if name.startswith("square-hole-"):
         return square_hole_builder(parse_count(name[len("square-hole-"):]))
-    sys.exit(f"unknown case {name!r}: rect-sin-a6, uniform-N-a6, uniform-N-a5, square-hole-N "
-             "(N like 35k)")
+    sys.exit(f"unknown case {name!r}: rect-sin-a6, uniform-N-a6, uniform-N-a5, disk-N-a5, "
+             "disk-N-a6, square-hole-N (N like 35k)")
 
 
 def triangle_mesh(name, build):

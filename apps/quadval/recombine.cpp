@@ -247,7 +247,7 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--cleanup-passes", o->cleanup_passes,
-                  "Rounds of quad-vertex-merge, doublet collapse and diagonal swaps of invalid quads (0: none)")
+                  "Rounds of quad-vertex-merge, doublet collapse and diagonal swaps of quads smoothing cannot mend (0: none)")
       ->capture_default_str();
   cmd->add_flag("--no-optimize", o->no_optimize, "No smoothing and no clean-up (Paper I §6)");
   cmd->add_flag("--full-quad", o->full_quad,

@@ -70,7 +70,7 @@ struct RecombineOptions {
   bool optimize = true;
   int smoothing_passes = 5;        ///< Laplacian sweeps before and after the clean-up; 0: none
   int max_cleanup_passes = 5;      ///< rounds of quad-vertex-merge, doublet collapse and diagonal
-                                   ///< swap of quads that are not valid; 0: none
+                                   ///< swap (quad_cleanup.hpp); 0: none
   /// Full-quad route: after recombination (and optimisation), split each quad into 4 and each
   /// triangle into 3 (Fig. 2). The size halves, as the paper notes.
   bool full_quad = false;
@@ -111,7 +111,7 @@ struct RecombineStats {
   std::size_t smoothing_moves = 0;
   std::size_t vertex_merges = 0;         ///< quad-vertex-merges (Fig. 10)
   std::size_t doublet_collapses = 0;     ///< doublet collapses (Fig. 11)
-  std::size_t diagonal_swaps = 0;        ///< invalid quads mended by a diagonal swap
+  std::size_t diagonal_swaps = 0;        ///< quads re-split with a neighbour (a corner smoothing cannot mend)
   // Final mesh.
   std::size_t quads = 0;
   std::size_t triangles = 0;             ///< triangles left (0 for an all-quad result)

@@ -152,32 +152,30 @@ bool surely_valid(const MixedMesh& m, std::uint32_t q) {
   return true;
 }
 
-// A corner that no smoothing can open: it and both its neighbours are fixed (they may
-// only slide along their straight side) and it is not strictly convex.
+// A frozen corner: it and both its neighbours are fixed (they may only slide along their
+// straight side), so no smoothing changes its angle. Stuck: frozen and not strictly convex.
+bool frozen_corner(const std::vector<char>& fixed, const std::array<NodeIndex, 4>& q, int k) {
+  return fixed[q[k]] && fixed[q[(k + 1) % 4]] && fixed[q[(k + 3) % 4]];
+}
+bool has_frozen_corner(const std::vector<char>& fixed, const std::array<NodeIndex, 4>& q) {
+  for (int k = 0; k < 4; ++k)
+    if (frozen_corner(fixed, q, k)) return true;
+  return false;
+}
 bool stuck_corner(const MixedMesh& m, const std::vector<char>& fixed, const std::array<NodeIndex, 4>& q,
                   const std::array<double, 3>& normal) {
-  for (int k = 0; k < 4; ++k) {
-    const NodeIndex v = q[k], next = q[(k + 1) % 4], prev = q[(k + 3) % 4];
-    if (fixed[v] && fixed[next] && fixed[prev] && !(corner_turn(m, v, next, prev, normal).cross_normal > 0))
+  for (int k = 0; k < 4; ++k)
+    if (frozen_corner(fixed, q, k) && !(corner_turn(m, q[k], q[(k + 1) % 4], q[(k + 3) % 4], normal).cross_normal > 0))
       return true;
-  }
   return false;
 }
 
-// Diagonal swap: quad q, not valid, and a quad q' across one of its edges form a hexagon
-// h0..h5 (q = h0 h1 h2 h5 and q' = h5 h2 h3 h4 around it, sharing h2-h5), which two quads
-// can also cover along h0-h3 or h1-h4. Takes the one of those whose worse quad scores
-// higher, if both its quads are valid, or, where q has a stuck corner, if neither of its
-// quads has one (smoothing then opens the rest). No node moves and the hexagon's outline
-// stays. The case that needs it: a boundary node in two triangles that the matching paired
-// makes a flat corner on a straight boundary, which no node position can mend.
-bool swap_diagonal(MixedMesh& m, Lists& at, const std::vector<char>& fixed, std::uint32_t q) {
-  if (element_score(m, q) > 0) return false;
-  const bool stuck = stuck_corner(m, fixed, m.elements[q], m.normal[q]);
-  bool found = false;
-  double best = 0;
-  std::uint32_t best_other = 0;
-  std::array<NodeIndex, 4> best_a{}, best_b{};
+// The other splits of the hexagon that quad q and a quad q' across one of its edges form:
+// h0..h5 around it, q = h0 h1 h2 h5 and q' = h5 h2 h3 h4 sharing h2-h5, which two quads can
+// also cover along h0-h3 or h1-h4. Calls f(q', a, b, normal) for each such pair of quads
+// (a, b) without a stuck corner whose new diagonal joins no other element.
+template <class F>
+void for_each_resplit(const MixedMesh& m, const Lists& at, const std::vector<char>& fixed, std::uint32_t q, F&& f) {
   for (int k = 0; k < 4; ++k) {
     const auto el = starting_at(m.elements[q], m.elements[q][(k + 2) % 4]);  // (h2, h5, h0, h1)
     const NodeIndex h2 = el[0], h5 = el[1], h0 = el[2], h1 = el[3];
@@ -204,28 +202,149 @@ bool swap_diagonal(MixedMesh& m, Lists& at, const std::vector<char>& fixed, std:
         const std::array<NodeIndex, 4> a{h[s], h[s + 1], h[s + 2], h[s + 3]};
         const std::array<NodeIndex, 4> b{h[s + 3], h[(s + 4) % 6], h[(s + 5) % 6], h[s]};
         if (stuck_corner(m, fixed, a, normal) || stuck_corner(m, fixed, b, normal)) continue;
-        const double worst = std::min(element_score(m, a, normal), element_score(m, b, normal));
-        if (!found || worst > best) {
-          found = true;
-          best = worst;
-          best_other = o;
-          best_a = a;
-          best_b = b;
-        }
+        f(o, a, b, normal);
       }
     }
   }
-  if (!found || !(best > 0 || stuck)) return false;
-  const std::uint32_t o = best_other;
+}
+
+// Replaces quads q and o by a and b (both with the given normal), keeping `at` in step.
+void resplit(MixedMesh& m, Lists& at, std::uint32_t q, std::uint32_t o, const std::array<NodeIndex, 4>& a,
+             const std::array<NodeIndex, 4>& b, const std::array<double, 3>& normal) {
   for (std::uint32_t e : {q, o})
     for (NodeIndex v : m.elements[e]) erase_value(at[v], e);
-  std::array<double, 3> normal;
-  for (int d = 0; d < 3; ++d) normal[d] = m.normal[q][d] + m.normal[o][d];
-  m.elements[q] = best_a;
-  m.elements[o] = best_b;
+  m.elements[q] = a;
+  m.elements[o] = b;
   m.normal[q] = m.normal[o] = normal;
   for (std::uint32_t e : {q, o})
     for (NodeIndex v : m.elements[e]) at[v].push_back(e);
+}
+
+// Diagonal swap of a quad q that is not valid: takes the split of for_each_resplit whose
+// worse quad scores higher, if both its quads are valid, or, where q has a stuck corner,
+// even if not (smoothing then opens the rest: its corners can move). No node moves and the
+// hexagon's outline stays. The case that needs it: a boundary node in two triangles that
+// the matching paired makes a flat corner on a straight boundary, which no node position can
+// mend.
+bool swap_diagonal(MixedMesh& m, Lists& at, const std::vector<char>& fixed, std::uint32_t q) {
+  if (element_score(m, q) > 0) return false;
+  const bool stuck = stuck_corner(m, fixed, m.elements[q], m.normal[q]);
+  bool found = false;
+  double best = 0;
+  std::uint32_t best_other = 0;
+  std::array<NodeIndex, 4> best_a{}, best_b{};
+  std::array<double, 3> best_normal{};
+  for_each_resplit(m, at, fixed, q, [&](std::uint32_t o, const auto& a, const auto& b, const auto& normal) {
+    const double worst = std::min(element_score(m, a, normal), element_score(m, b, normal));
+    if (!found || worst > best) {
+      found = true;
+      best = worst;
+      best_other = o;
+      best_a = a;
+      best_b = b;
+      best_normal = normal;
+    }
+  });
+  if (!found || !(best > 0 || stuck)) return false;
+  resplit(m, at, q, best_other, best_a, best_b, best_normal);
+  return true;
+}
+
+// The worst score of the elements at node v.
+double worst_at(const MixedMesh& m, const Lists& at, NodeIndex v) {
+  double worst = 2.0;
+  for (std::uint32_t e : at[v]) worst = std::min(worst, element_score(m, e));
+  return worst;
+}
+
+// A few sweeps over the free nodes `nodes`: each moves to the mean of its edge neighbours, or
+// half way, when that raises the worst score of its elements (as smooth() does).
+void relax(MixedMesh& m, const Lists& at, const std::vector<NodeIndex>& nodes) {
+  for (int sweep = 0; sweep < 3; ++sweep)
+    for (NodeIndex v : nodes) {
+      std::array<double, 3> mean{0, 0, 0};
+      int count = 0;
+      for (std::uint32_t e : at[v]) {
+        const int i = corner_of(m.elements[e], v);
+        for (NodeIndex j : {next_corner(m.elements[e], i), prev_corner(m.elements[e], i)}) {
+          const auto p = m.point(j);
+          for (int d = 0; d < 3; ++d) mean[d] += p[d];
+          ++count;
+        }
+      }
+      const auto x = m.point(v);
+      double* c = &m.coords[3 * std::size_t{v}];
+      double best = worst_at(m, at, v);
+      std::array<double, 3> keep = x;
+      for (const double t : {1.0, 0.5}) {
+        for (int d = 0; d < 3; ++d) c[d] = x[d] + t * (mean[d] / count - x[d]);
+        if (const double w = worst_at(m, at, v); w > best) {
+          best = w;
+          keep = {c[0], c[1], c[2]};
+        }
+      }
+      for (int d = 0; d < 3; ++d) c[d] = keep[d];
+    }
+}
+
+// Diagonal swap of a valid quad q with a frozen corner, whose angle no smoothing changes
+// (e.g. a boundary node on a curve that only q holds: nearly 180 degrees): each split of
+// for_each_resplit is tried with the free nodes of its hexagon relaxed, and the one whose
+// worst element around the hexagon scores highest is kept if that beats the worst there
+// before; otherwise nothing changes.
+bool swap_frozen(MixedMesh& m, Lists& at, const std::vector<char>& fixed, std::uint32_t q) {
+  if (!has_frozen_corner(fixed, m.elements[q]) || !(element_score(m, q) > 0)) return false;
+  struct Trial {
+    std::uint32_t o;
+    std::array<NodeIndex, 4> a, b;
+    std::array<double, 3> normal;
+  };
+  std::vector<Trial> trials;
+  for_each_resplit(m, at, fixed, q, [&](std::uint32_t o, const auto& a, const auto& b, const auto& normal) {
+    trials.push_back({o, a, b, normal});
+  });
+  bool found = false;
+  double best_gain = 0;
+  Trial best{};
+  std::vector<std::pair<NodeIndex, std::array<double, 3>>> best_coords;
+  for (const Trial& t : trials) {
+    std::vector<NodeIndex> free;
+    std::vector<std::uint32_t> around;  // the elements whose shape the trial can change
+    for (const auto& e : {m.elements[q], m.elements[t.o]})
+      for (NodeIndex v : e) {
+        if (!fixed[v] && std::find(free.begin(), free.end(), v) == free.end()) free.push_back(v);
+        for (std::uint32_t x : at[v])
+          if (std::find(around.begin(), around.end(), x) == around.end()) around.push_back(x);
+      }
+    const auto worst_around = [&] {
+      double w = 2.0;
+      for (std::uint32_t e : around) w = std::min(w, element_score(m, e));
+      return w;
+    };
+    const double before = worst_around();
+    std::vector<std::pair<NodeIndex, std::array<double, 3>>> saved;
+    for (NodeIndex v : free) saved.push_back({v, m.point(v)});
+    const std::array<NodeIndex, 4> old_q = m.elements[q], old_o = m.elements[t.o];
+    const std::array<double, 3> normal_q = m.normal[q], normal_o = m.normal[t.o];
+    resplit(m, at, q, t.o, t.a, t.b, t.normal);
+    relax(m, at, free);
+    const double after = worst_around();
+    if (after > 0 && after > before && (!found || after - before > best_gain)) {
+      found = true;
+      best_gain = after - before;
+      best = t;
+      best_coords.clear();
+      for (NodeIndex v : free) best_coords.push_back({v, m.point(v)});
+    }
+    resplit(m, at, q, t.o, old_q, old_o, normal_q);  // undo
+    m.normal[t.o] = normal_o;
+    for (const auto& [v, x] : saved)
+      for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d];
+  }
+  if (!found) return false;
+  resplit(m, at, q, best.o, best.a, best.b, best.normal);
+  for (const auto& [v, x] : best_coords)
+    for (int d = 0; d < 3; ++d) m.coords[3 * std::size_t{v} + d] = x[d];
   return true;
 }
 
@@ -235,29 +354,31 @@ CleanupCounts cleanup_quads(MixedMesh& m, const std::vector<char>& fixed, int ma
   CleanupCounts counts;
   if (max_passes <= 0) return counts;
   Lists at = node_elements(m);
-  // The quads that are not valid, found once: the collapses and merges add those they leave
-  // so (they can only where one of theirs was already).
-  std::vector<std::uint32_t> invalid;
+  // The quads to try a diagonal swap on, found once: those that are not valid or have a
+  // frozen corner. The collapses and merges add the quads they leave not valid (they can only
+  // where one of theirs was already) and make no frozen corner (they move no fixed node).
+  std::vector<std::uint32_t> to_swap;
   for (std::uint32_t q = 0; q < m.elements.size(); ++q)
-    if (m.alive[q] && m.is_quad(q) && !surely_valid(m, q) && !(element_score(m, q) > 0))
-      invalid.push_back(q);
+    if (m.alive[q] && m.is_quad(q) &&
+        (has_frozen_corner(fixed, m.elements[q]) || (!surely_valid(m, q) && !(element_score(m, q) > 0))))
+      to_swap.push_back(q);
   for (int pass = 0; pass < max_passes; ++pass) {
     std::size_t changes = 0;
     for (NodeIndex v = 0; v < m.num_nodes(); ++v)
-      if (!fixed[v] && collapse_doublet(m, at, v, invalid)) {
+      if (!fixed[v] && collapse_doublet(m, at, v, to_swap)) {
         ++counts.doublet_collapses;
         ++changes;
       }
-    std::erase_if(invalid, [&m](std::uint32_t q) { return !m.alive[q] || element_score(m, q) > 0; });
-    for (std::uint32_t q : invalid)
-      if (m.is_quad(q) && swap_diagonal(m, at, fixed, q)) {
+    std::erase_if(to_swap, [&m](std::uint32_t q) { return !m.alive[q] || !m.is_quad(q); });
+    for (std::uint32_t q : to_swap)
+      if (swap_diagonal(m, at, fixed, q) || swap_frozen(m, at, fixed, q)) {
         ++counts.diagonal_swaps;
         ++changes;
       }
     for (std::uint32_t q = 0; q < m.elements.size(); ++q) {
       if (!m.alive[q] || !m.is_quad(q)) continue;
       for (int first = 0; first < 2; ++first)
-        if (merge_diagonal(m, at, fixed, q, first, invalid)) {
+        if (merge_diagonal(m, at, fixed, q, first, to_swap)) {
           ++counts.vertex_merges;
           ++changes;
           break;

@@ -1,7 +1,7 @@
 #pragma once
 // Topological clean-up of Paper I §6: quad-vertex-merge (Fig. 10) and doublet collapse
-// (Fig. 11), which delete one quad each and never touch a fixed (boundary) node; and, for
-// the quads that are still not valid, a diagonal swap with a neighbouring quad.
+// (Fig. 11), which delete one quad each and never touch a fixed (boundary) node; and, ours,
+// a diagonal swap with a neighbouring quad for the quads whose shape smoothing cannot mend.
 
 #include <cstddef>
 #include <vector>
@@ -25,11 +25,16 @@ struct CleanupCounts {
 ///   node (at their midpoint, or else at the mean of its edge neighbours) in four quads.
 ///   Kept only if b and d keep at least 3 quads (2 on the boundary) and the worst score of
 ///   the four quads is positive or not below the worst of the five before (never inverts).
-/// - Diagonal swap: a quad that is not valid (score <= 0) and a quad of its region across one
-///   of its edges are re-split along one of the two other diagonals of their hexagon, the
-///   one whose worse quad scores higher, if both its quads are valid (and no element outside
-///   the two already joins that diagonal's ends). No node moves: it mends what smoothing
-///   cannot, such as a flat corner at a boundary node that the matching left in one quad.
+/// - Diagonal swap, for a quad that is not valid (score <= 0) or has a frozen corner (it and
+///   both its neighbours fixed: no smoothing changes its angle): it and a quad of its region
+///   across one of its edges are re-split along one of the two other diagonals of their
+///   hexagon (never one that already joins two nodes of another element, never into a quad
+///   with a stuck corner, i.e. frozen and not strictly convex). A quad that is not valid takes
+///   the split whose worse quad scores higher if both are valid, or, if it has a stuck corner,
+///   even if not (smoothing opens the rest). A valid quad with a frozen corner takes the split
+///   that, with the free nodes of the hexagon relaxed, most raises the worst score of the
+///   elements there, if any does. It mends what smoothing cannot: a corner of (nearly)
+///   180 degrees at a boundary node that only that quad holds.
 /// Removed nodes stay in the arrays, unreferenced.
 CleanupCounts cleanup_quads(MixedMesh& m, const std::vector<char>& fixed, int max_passes);
 

@@ -1,5 +1,5 @@
-// The diagonal swap of the clean-up: a quad with a flat corner at a boundary node, which no
-// smoothing can open, is re-split with its neighbour.
+// The diagonal swaps of the clean-up: a quad with a flat (or nearly flat) corner at a
+// boundary node, which no smoothing can open, is re-split with its neighbour.
 #include <algorithm>
 #include <set>
 #include <utility>
@@ -108,7 +108,27 @@ TEST(QuadCleanup, SwapNeedsASplitWithoutStuckCorners) {
   recombine_detail::polish_worst(m4, fixed4, {});
   for (std::size_t e = 0; e < 2; ++e) EXPECT_GT(recombine_detail::element_score(m4, e), 0.0) << e;
 
-  // Valid quads are never swapped.
+  // b a little below the line a-c: the quad (a, b, c, x) is valid, but its corner at b, of
+  // about 174 degrees, is frozen (a, b, c fixed). The split along a-e keeps that corner;
+  // along b-f (by hand, as above) it is cut in two, so that split is taken, and the worst
+  // score of the two quads rises. Fixed nodes stay, the outline too.
+  std::vector<std::array<double, 2>> bent = kNodes;
+  bent[B] = {1, -0.05};
+  MixedMesh m5 = two_quads(bent, {A, B, C, X}, {X, C, E, F});
+  const std::vector<char> fixed5 = {1, 1, 1, 0, 0, 0};
+  const double before5 = std::min(recombine_detail::element_score(m5, 0), recombine_detail::element_score(m5, 1));
+  EXPECT_GT(before5, 0.0);
+  EXPECT_LT(before5, 0.1);
+  const auto coords5 = m5.coords;
+  EXPECT_EQ(recombine_detail::cleanup_quads(m5, fixed5, 5).diagonal_swaps, 1u);
+  EXPECT_GT(std::min(recombine_detail::element_score(m5, 0), recombine_detail::element_score(m5, 1)), before5);
+  for (NodeIndex v : {A, B, C})
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(m5.coords[3 * v + d], coords5[3 * v + d]);
+  std::set<std::set<NodeIndex>> split5;
+  for (const auto& q : m5.elements) split5.insert(std::set<NodeIndex>(q.begin(), q.end()));
+  EXPECT_EQ(split5, (std::set<std::set<NodeIndex>>{{B, C, E, F}, {F, X, A, B}}));
+
+  // Valid quads without a frozen corner are never swapped.
   MixedMesh m3 = two_quads(kNodes, {B, C, E, F}, {F, X, A, B});
   const auto valid = m3.elements;
   EXPECT_EQ(recombine_detail::cleanup_quads(m3, {1, 1, 1, 0, 0, 0}, 5).diagonal_swaps, 0u);
