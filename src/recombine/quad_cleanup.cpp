@@ -1,6 +1,9 @@
 #include "quad_cleanup.hpp"
 
 #include <algorithm>
+#include <cmath>
+
+#include "smoothing.hpp"
 
 namespace quadval::recombine_detail {
 
@@ -260,7 +263,7 @@ double worst_at(const MixedMesh& m, const Lists& at, NodeIndex v) {
 // A few sweeps over the free nodes `nodes`: each moves to the mean of its edge neighbours, or
 // half way, when that raises the worst score of its elements (as smooth() does).
 void relax(MixedMesh& m, const Lists& at, const std::vector<NodeIndex>& nodes) {
-  for (int sweep = 0; sweep < 3; ++sweep)
+  for (int sweep = 0; sweep < 2; ++sweep)
     for (NodeIndex v : nodes) {
       std::array<double, 3> mean{0, 0, 0};
       int count = 0;
@@ -287,13 +290,13 @@ void relax(MixedMesh& m, const Lists& at, const std::vector<NodeIndex>& nodes) {
     }
 }
 
-// Diagonal swap of a valid quad q with a frozen corner, whose angle no smoothing changes
-// (e.g. a boundary node on a curve that only q holds: nearly 180 degrees): each split of
-// for_each_resplit is tried with the free nodes of its hexagon relaxed, and the one whose
-// worst element around the hexagon scores highest is kept if that beats the worst there
-// before; otherwise nothing changes.
-bool swap_frozen(MixedMesh& m, Lists& at, const std::vector<char>& fixed, std::uint32_t q) {
-  if (!has_frozen_corner(fixed, m.elements[q]) || !(element_score(m, q) > 0)) return false;
+// Diagonal swap of a valid quad q (with a frozen corner, whose angle no smoothing changes,
+// e.g. at a boundary node on a curve that only q holds: nearly 180 degrees; or one of the
+// worst, see swap_worst): each split of for_each_resplit is tried with the free nodes of its
+// hexagon relaxed, and the one whose worst element around the hexagon scores highest is
+// kept if that beats the worst there before; otherwise nothing changes.
+bool swap_if_better(MixedMesh& m, Lists& at, const std::vector<char>& fixed, std::uint32_t q) {
+  if (!(element_score(m, q) > 0)) return false;
   struct Trial {
     std::uint32_t o;
     std::array<NodeIndex, 4> a, b;
@@ -371,7 +374,8 @@ CleanupCounts cleanup_quads(MixedMesh& m, const std::vector<char>& fixed, int ma
       }
     std::erase_if(to_swap, [&m](std::uint32_t q) { return !m.alive[q] || !m.is_quad(q); });
     for (std::uint32_t q : to_swap)
-      if (swap_diagonal(m, at, fixed, q) || swap_frozen(m, at, fixed, q)) {
+      if (swap_diagonal(m, at, fixed, q) ||
+          (has_frozen_corner(fixed, m.elements[q]) && swap_if_better(m, at, fixed, q))) {
         ++counts.diagonal_swaps;
         ++changes;
       }
@@ -387,6 +391,36 @@ CleanupCounts cleanup_quads(MixedMesh& m, const std::vector<char>& fixed, int ma
     if (changes == 0) break;
   }
   return counts;
+}
+
+std::size_t swap_worst(MixedMesh& m, const std::vector<char>& fixed, double share, int rounds,
+                       std::vector<char>* near) {
+  Lists at = node_elements(m);
+  std::size_t swaps = 0;
+  for (int round = 0; round < rounds; ++round) {
+    std::vector<std::pair<double, std::uint32_t>> scores;
+    for (std::uint32_t q = 0; q < m.elements.size(); ++q) {
+      if (!m.alive[q] || !m.is_quad(q)) continue;
+      const auto& n = m.normal[q];
+      scores.push_back({smoothing_score(m.coords, m.elements[q], n, std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])), q});
+    }
+    const auto worst = std::min(scores.size(), std::max<std::size_t>(16, static_cast<std::size_t>(share * static_cast<double>(scores.size()))));
+    std::partial_sort(scores.begin(), scores.begin() + static_cast<std::ptrdiff_t>(worst), scores.end());
+    std::size_t made = 0;
+    for (std::size_t i = 0; i < worst; ++i) {
+      const std::uint32_t q = scores[i].second;
+      if (!swap_if_better(m, at, fixed, q)) continue;
+      ++made;
+      if (!near) continue;
+      near->resize(m.num_nodes(), 0);
+      for (NodeIndex v : m.elements[q])  // q and its partner share a node: their rings cover both
+        for (std::uint32_t e : at[v])
+          for (int k = 0; k < MixedMesh::size(m.elements[e]); ++k) (*near)[m.elements[e][k]] = 1;
+    }
+    swaps += made;
+    if (made == 0) break;
+  }
+  return swaps;
 }
 
 }  // namespace quadval::recombine_detail

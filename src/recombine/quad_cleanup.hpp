@@ -1,7 +1,8 @@
 #pragma once
 // Topological clean-up of Paper I §6: quad-vertex-merge (Fig. 10) and doublet collapse
 // (Fig. 11), which delete one quad each and never touch a fixed (boundary) node; and, ours,
-// a diagonal swap with a neighbouring quad for the quads whose shape smoothing cannot mend.
+// diagonal swaps with a neighbouring quad: for the quads whose shape smoothing cannot mend,
+// and (swap_worst) at the worst quads once the mesh is smoothed.
 
 #include <cstddef>
 #include <vector>
@@ -37,5 +38,15 @@ struct CleanupCounts {
 ///   180 degrees at a boundary node that only that quad holds.
 /// Removed nodes stay in the arrays, unreferenced.
 CleanupCounts cleanup_quads(MixedMesh& m, const std::vector<char>& fixed, int max_passes);
+
+/// The last step of the optimisation: up to `rounds` rounds, each over the worst `share` of
+/// the quads (at least 16), worst first, of the diagonal swap for valid quads (as in
+/// cleanup_quads, with the hexagon's free nodes relaxed), kept only where it raises the
+/// worst score of the elements around the hexagon. So the mesh's worst quad never gets worse
+/// and no element is inverted. Returns the swaps made.
+/// @param near  if given, set to 1 (resized to #nodes) at the nodes of the elements around
+///              each swapped quad's corners, for a local smoothing after
+std::size_t swap_worst(MixedMesh& m, const std::vector<char>& fixed, double share = 0.002, int rounds = 2,
+                       std::vector<char>* near = nullptr);
 
 }  // namespace quadval::recombine_detail

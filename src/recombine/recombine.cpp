@@ -124,6 +124,36 @@ void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& op
     stats.smoothing_moves += moves;
     timer.stage("polish", fmt::format("{} moves at the worst elements", moves));
   }
+  if (options.max_cleanup_passes > 0) {
+    std::vector<char> near;
+    const std::size_t swaps = swap_worst(m, fixed, 0.002, 2, &near);
+    stats.diagonal_swaps += swaps;
+    timer.stage("swap", fmt::format("{} diagonal swaps at the worst quads", swaps));
+    if (swaps > 0 && options.smoothing_passes > 0) {
+      // Smoothing around the swaps only (it never lowers eta_min): the rest is smoothed already.
+      // Two rings: the swapped quads' elements, and theirs.
+      std::vector<char> ring = near;
+      for (const auto& e : m.elements) {
+        if (e[0] == kNoNode) continue;
+        bool touches = false;
+        for (int k = 0; k < MixedMesh::size(e); ++k) touches = touches || near[e[k]];
+        if (touches)
+          for (int k = 0; k < MixedMesh::size(e); ++k) ring[e[k]] = 1;
+      }
+      near.swap(ring);
+      std::vector<char> held(fixed);
+      auto slides_now = straight_boundary_slides(m, fixed);
+      for (NodeIndex v = 0; v < m.num_nodes(); ++v)
+        if (!near[v]) {
+          held[v] = 1;
+          slides_now[v] = {kNoNode, kNoNode};
+        }
+      smoothing.slides = &slides_now;
+      const std::size_t moves = smooth(m, held, smoothing);
+      stats.smoothing_moves += moves;
+      timer.stage("smooth", fmt::format("{} moves around the swaps", moves));
+    }
+  }
 }
 
 Mesh to_mesh(const MixedMesh& m, const Mesh& input, const TriangleSurface& s) {

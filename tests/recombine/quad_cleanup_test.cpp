@@ -1,6 +1,8 @@
 // The diagonal swaps of the clean-up: a quad with a flat (or nearly flat) corner at a
 // boundary node, which no smoothing can open, is re-split with its neighbour.
 #include <algorithm>
+#include <map>
+#include <random>
 #include <set>
 #include <utility>
 
@@ -133,6 +135,66 @@ TEST(QuadCleanup, SwapNeedsASplitWithoutStuckCorners) {
   const auto valid = m3.elements;
   EXPECT_EQ(recombine_detail::cleanup_quads(m3, {1, 1, 1, 0, 0, 0}, 5).diagonal_swaps, 0u);
   EXPECT_EQ(m3.elements, valid);
+}
+
+// A jittered nx x ny grid of quads (boundary nodes fixed, not moved): swap_worst never lowers
+// the worst score, keeps every quad valid, the outline and the conformity, and does swap.
+TEST(QuadCleanup, SwapWorstRaisesTheWorstQuadAndKeepsTheMeshSound) {
+  std::size_t swapped = 0;
+  for (unsigned seed = 1; seed <= 20; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-0.3, 0.3);
+    const int n = 12;
+    std::vector<std::array<double, 2>> xy;
+    std::vector<char> fixed;
+    for (int j = 0; j <= n; ++j)
+      for (int i = 0; i <= n; ++i) {
+        const bool boundary = i == 0 || j == 0 || i == n || j == n;
+        xy.push_back({i + (boundary ? 0 : u(rng)), j + (boundary ? 0 : u(rng))});
+        fixed.push_back(boundary ? 1 : 0);
+      }
+    MixedMesh m;
+    for (std::size_t i = 0; i < xy.size(); ++i) m.add_node({xy[i][0], xy[i][1], 0.0}, static_cast<Tag>(i + 1));
+    const auto id = [n](int i, int j) { return static_cast<NodeIndex>(j * (n + 1) + i); };
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        m.elements.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+        m.region.push_back(0);
+        m.normal.push_back({0, 0, 1});
+        m.alive.push_back(1);
+      }
+    const auto worst = [&m] {
+      double w = 2;
+      for (std::size_t e = 0; e < m.elements.size(); ++e) w = std::min(w, recombine_detail::element_score(m, e));
+      return w;
+    };
+    const auto edges = [&m](bool boundary_only) {
+      std::map<std::pair<NodeIndex, NodeIndex>, int> count;  // undirected
+      for (const auto& q : m.elements)
+        for (int k = 0; k < 4; ++k) ++count[std::minmax(q[k], q[(k + 1) % 4])];
+      std::set<std::pair<NodeIndex, NodeIndex>> out;
+      for (const auto& [e, c] : count) {
+        EXPECT_LE(c, 2) << "edge " << e.first << "-" << e.second;
+        if (!boundary_only || c == 1) out.insert(e);
+      }
+      return out;
+    };
+    const double before = worst();
+    ASSERT_GT(before, 0.0) << seed;
+    const auto outline = edges(true);
+    const std::size_t swaps = recombine_detail::swap_worst(m, fixed, 0.05, 3);
+    swapped += swaps;
+    EXPECT_GE(worst(), before) << seed;
+    EXPECT_EQ(edges(true), outline) << seed;
+    std::set<std::pair<NodeIndex, NodeIndex>> directed;
+    for (const auto& q : m.elements)
+      for (int k = 0; k < 4; ++k) EXPECT_TRUE(directed.insert({q[k], q[(k + 1) % 4]}).second) << seed;
+    for (std::size_t v = 0; v < fixed.size(); ++v) {
+      if (!fixed[v]) continue;
+      for (int d = 0; d < 2; ++d) EXPECT_EQ(m.coords[3 * v + d], xy[v][d]);
+    }
+  }
+  EXPECT_GT(swapped, 0u);
 }
 
 }  // namespace
