@@ -96,6 +96,31 @@ MixedMesh mesh_from_matching(const TriangleSurface& s, const DualGraph& g, const
   return m;
 }
 
+// Smooths only the nodes within one more ring of elements around the marked ones (`near`),
+// the rest held: after the last swaps, the mesh elsewhere is smoothed already. Smoothing
+// never lowers the worst score, so eta_min stays.
+std::size_t smooth_near(MixedMesh& m, const std::vector<char>& fixed, const std::vector<char>& near,
+                        SmoothingOptions smoothing) {
+  std::vector<char> ring = near;
+  for (std::size_t e = 0; e < m.elements.size(); ++e) {
+    if (!m.alive[e]) continue;
+    const auto& el = m.elements[e];
+    bool touches = false;
+    for (int k = 0; k < MixedMesh::size(el); ++k) touches = touches || near[el[k]];
+    if (touches)
+      for (int k = 0; k < MixedMesh::size(el); ++k) ring[el[k]] = 1;
+  }
+  std::vector<char> held(fixed);
+  auto slides = straight_boundary_slides(m, fixed);
+  for (NodeIndex v = 0; v < m.num_nodes(); ++v)
+    if (!ring[v]) {
+      held[v] = 1;
+      slides[v] = {kNoNode, kNoNode};
+    }
+  smoothing.slides = &slides;
+  return smooth(m, held, smoothing);
+}
+
 void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& options,
               RecombineStats& stats, StageTimer& timer) {
   const std::vector<char> fixed = region_boundary_nodes(m);
@@ -130,26 +155,7 @@ void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& op
     stats.diagonal_swaps += swaps;
     timer.stage("swap", fmt::format("{} diagonal swaps at the worst quads", swaps));
     if (swaps > 0 && options.smoothing_passes > 0) {
-      // Smoothing around the swaps only (it never lowers eta_min): the rest is smoothed already.
-      // Two rings: the swapped quads' elements, and theirs.
-      std::vector<char> ring = near;
-      for (const auto& e : m.elements) {
-        if (e[0] == kNoNode) continue;
-        bool touches = false;
-        for (int k = 0; k < MixedMesh::size(e); ++k) touches = touches || near[e[k]];
-        if (touches)
-          for (int k = 0; k < MixedMesh::size(e); ++k) ring[e[k]] = 1;
-      }
-      near.swap(ring);
-      std::vector<char> held(fixed);
-      auto slides_now = straight_boundary_slides(m, fixed);
-      for (NodeIndex v = 0; v < m.num_nodes(); ++v)
-        if (!near[v]) {
-          held[v] = 1;
-          slides_now[v] = {kNoNode, kNoNode};
-        }
-      smoothing.slides = &slides_now;
-      const std::size_t moves = smooth(m, held, smoothing);
+      const std::size_t moves = smooth_near(m, fixed, near, smoothing);
       stats.smoothing_moves += moves;
       timer.stage("smooth", fmt::format("{} moves around the swaps", moves));
     }
