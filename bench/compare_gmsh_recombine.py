@@ -148,27 +148,28 @@ def build_rect_sin():
     gmsh.open(os.path.join(SHARED, "rect-sin.geo"))
 
 
+def uniform_model(name, add_shape, h, algorithm):
+    """A new model holding one OCC surface (add_shape()), meshed with size h everywhere by
+    Gmsh's Delaunay (5) or Frontal-Delaunay (6)."""
+    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
+    gmsh.model.add(name)
+    add_shape()
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+
+
 def build_uniform(triangles, algorithm=6):
     """Unit square, uniform size: about 2.3 / h^2 triangles for Frontal-Delaunay (6); with
     Delaunay (5), about 2.65 / h^2."""
     h = ((2.3 if algorithm == 6 else 2.65) / triangles) ** 0.5
-    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
-    gmsh.model.add("square")
-    gmsh.model.occ.addRectangle(0, 0, 0, 1, 1)
-    gmsh.model.occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+    uniform_model("square", lambda: gmsh.model.occ.addRectangle(0, 0, 0, 1, 1), h, algorithm)
 
 
 def build_disk(triangles, algorithm):
-    """Unit-diameter disk, uniform size, Gmsh's Delaunay (5) or Frontal-Delaunay (6)."""
+    """Unit-diameter disk, uniform size (about 2.5 area / h^2 triangles)."""
     h = ((2.5 * math.pi / 4) / triangles) ** 0.5
-    gmsh.option.setNumber("Mesh.Algorithm", algorithm)
-    gmsh.model.add("disk")
-    gmsh.model.occ.addDisk(0.5, 0.5, 0, 0.5, 0.5)
-    gmsh.model.occ.synchronize()
-    gmsh.option.setNumber("Mesh.MeshSizeMin", h)
-    gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+    uniform_model("disk", lambda: gmsh.model.occ.addDisk(0.5, 0.5, 0, 0.5, 0.5), h, algorithm)
 
 
 def build_square_hole(h_min):
