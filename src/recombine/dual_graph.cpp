@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "quadval/error.hpp"
 #include "quadval/quad_quality.hpp"
@@ -65,7 +66,9 @@ DualGraph build_dual_graph(const DualGraphInput& in) {
   const auto& coords = *in.coords;
   const auto& tris = *in.triangles;
   const auto& region = *in.region;
-  const TriangleTopology topo = build_triangle_topology(tris, in.num_nodes);
+  std::optional<TriangleTopology> built;
+  const TriangleTopology& topo =
+      in.topology != nullptr ? *in.topology : built.emplace(build_triangle_topology(tris, in.num_nodes));
   DualGraph g;
   g.num_triangles = static_cast<std::uint32_t>(tris.size());
   g.pairs.reserve(3 * tris.size() / 2 + 16);

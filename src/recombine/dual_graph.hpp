@@ -9,6 +9,7 @@
 
 #include "quadval/mesh.hpp"
 #include "quadval/recombine.hpp"
+#include "quadval/topology.hpp"
 
 namespace quadval::recombine_detail {
 
@@ -65,6 +66,8 @@ struct DualGraphInput {
   double extra_edge_cost = 1000.0;
   /// Triangle pairs (t0 < t1) never to merge (the halves of a split triangle).
   const std::vector<std::array<std::uint32_t, 2>>* forbidden_pairs = nullptr;
+  /// The topology of `triangles`, or null: built here.
+  const TriangleTopology* topology = nullptr;
 };
 
 /// Builds the graph. Extra pairs (§5.3) join the triangles t, t' of two successive boundary

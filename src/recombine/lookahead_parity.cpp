@@ -1,13 +1,16 @@
 #include "lookahead_parity.hpp"
 
 #include <algorithm>
+#include <optional>
 
 #include "quadval/topology.hpp"
 
 namespace quadval::recombine_detail {
 
 void make_pieces_even(TriangleSurface& s) {
-  const TriangleTopology topo = build_triangle_topology(s.triangles, s.node_tags.size());
+  std::optional<TriangleTopology> built;
+  const TriangleTopology& topo =
+      s.topology ? *s.topology : built.emplace(build_triangle_topology(s.triangles, s.node_tags.size()));
   const auto n = static_cast<std::uint32_t>(s.triangles.size());
   // Pieces: components over edges shared by two triangles of the same region.
   std::vector<std::int32_t> piece(n, -1);

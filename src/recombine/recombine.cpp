@@ -211,9 +211,12 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   RecombineStats& stats = result.stats;
   StageTimer timer(stats, options);
 
-  TriangleSurface s = prepare_triangles(input, options.source, result.warnings);
-  order_nodes_along_curve(s);  // memory locality; the output keeps the input's node order
+  // In locality order before the checks too (node_order.hpp); the output keeps the input's
+  // node order.
+  TriangleSurface s = collect_triangles(input, options.source, result.warnings);
+  order_nodes_along_curve(s);
   order_triangles_along_curve(s);
+  validate_triangles(s, options.source, result.warnings);
   stats.input_triangles = s.triangles.size();
   if (options.cost == PairCostKind::cross_field && !options.cross_field_per_triangle.empty() &&
       options.cross_field_per_triangle.size() != s.triangles.size())
@@ -246,8 +249,10 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   DualGraphInput gin{&s.coords, &s.triangles, &s.region, s.node_tags.size(), options.cost,
                      &field, options.cross_field_angle,
                      options.extra_edges && options.algorithm == RecombineAlgorithm::blossom,
-                     options.extra_edge_cost, &s.forbidden_pairs};
+                     options.extra_edge_cost, &s.forbidden_pairs,
+                     s.topology ? &*s.topology : nullptr};
   const DualGraph graph = build_dual_graph(gin);
+  s.topology.reset();  // not needed below
   stats.graph_pairs = graph.num_real;
   stats.extra_pairs = graph.pairs.size() - graph.num_real;
   timer.stage("graph", fmt::format("{} pairs, {} extra", stats.graph_pairs, stats.extra_pairs));

@@ -79,20 +79,29 @@ void check_shapes(const std::string& source, const TriangleSurface& s) {
           fmt::format("triangle has zero area (nodes {} {} {} are collinear or repeated)",
                       s.node_tags[v[0]], s.node_tags[v[1]], s.node_tags[v[2]]));
   }
-  // The same three nodes twice.
-  std::vector<std::pair<std::array<NodeIndex, 3>, std::uint32_t>> keys(s.triangles.size());
-  for (std::size_t t = 0; t < s.triangles.size(); ++t) {
-    auto k = s.triangles[t];
-    std::sort(k.begin(), k.end());
-    keys[t] = {k, static_cast<std::uint32_t>(t)};
+}
+
+// The same three nodes twice: such triangles share every edge, so it is enough to compare the
+// third nodes of the triangles around each edge (before check_manifold, which would report the
+// edges of a duplicate inside the surface as non-manifold).
+void check_duplicates(const std::string& source, const TriangleSurface& s,
+                      const TriangleTopology& topo) {
+  for (std::uint32_t e = 0; e < topo.num_edges(); ++e) {
+    const std::uint32_t first = topo.edge_triangle_offsets[e], last = topo.edge_triangle_offsets[e + 1];
+    const auto third = [&](std::uint32_t t) {
+      const auto& v = s.triangles[t];
+      return v[0] + v[1] + v[2] - topo.edges[e][0] - topo.edges[e][1];  // wraps consistently
+    };
+    for (std::uint32_t i = first; i < last; ++i)
+      for (std::uint32_t j = i + 1; j < last; ++j) {
+        const std::uint32_t a = topo.edge_triangles[i], b = topo.edge_triangles[j];
+        if (third(a) != third(b)) continue;
+        const Tag low = std::min(s.triangle_tags[a], s.triangle_tags[b]);
+        const Tag high = std::max(s.triangle_tags[a], s.triangle_tags[b]);
+        throw InputError::in_element(
+            source, high, fmt::format("duplicate triangle: same three nodes as element {}", low));
+      }
   }
-  std::sort(keys.begin(), keys.end());
-  for (std::size_t i = 1; i < keys.size(); ++i)
-    if (keys[i].first == keys[i - 1].first)
-      throw InputError::in_element(
-          source, s.triangle_tags[std::max(keys[i].second, keys[i - 1].second)],
-          fmt::format("duplicate triangle: same three nodes as element {}",
-                      s.triangle_tags[std::min(keys[i].second, keys[i - 1].second)]));
 }
 
 void check_manifold(const std::string& source, const TriangleSurface& s,
@@ -164,16 +173,31 @@ void orient(const std::string& source, TriangleSurface& s, const TriangleTopolog
 
 }  // namespace
 
-TriangleSurface prepare_triangles(const Mesh& mesh, const std::string& source,
+TriangleSurface collect_triangles(const Mesh& mesh, const std::string& source,
                                   std::vector<std::string>& warnings) {
   TriangleSurface s;
   s.coords = mesh.coords;
   s.node_tags = mesh.node_tags;
   collect(mesh, source, s, warnings);
+  return s;
+}
+
+void validate_triangles(TriangleSurface& s, const std::string& source,
+                        std::vector<std::string>& warnings) {
   check_shapes(source, s);
-  const TriangleTopology topo = build_triangle_topology(s.triangles, s.node_tags.size());
+  TriangleTopology topo = build_triangle_topology(s.triangles, s.node_tags.size());
+  check_duplicates(source, s, topo);
   check_manifold(source, s, topo);
   orient(source, s, topo);
+  // A reversed triangle (a, c, b) holds the edges of (a, b, c) in the order 2, 1, 0.
+  for (std::size_t t = 0; t < s.triangles.size(); ++t)
+    if (topo.triangles[t] != s.triangles[t]) {
+      topo.triangles[t] = s.triangles[t];
+      std::swap(topo.triangle_edges[t][0], topo.triangle_edges[t][2]);
+      std::swap(topo.neighbors[t][0], topo.neighbors[t][2]);
+    }
+  topo.num_misoriented_edges = 0;
+  s.topology = std::move(topo);
   if (s.flipped > 0)
     warnings.push_back(fmt::format(
         "{} triangles were reversed to give each connected surface one orientation", s.flipped));
@@ -182,6 +206,12 @@ TriangleSurface prepare_triangles(const Mesh& mesh, const std::string& source,
       s.planar = false;
       break;
     }
+}
+
+TriangleSurface prepare_triangles(const Mesh& mesh, const std::string& source,
+                                  std::vector<std::string>& warnings) {
+  TriangleSurface s = collect_triangles(mesh, source, warnings);
+  validate_triangles(s, source, warnings);
   return s;
 }
 
@@ -193,7 +223,9 @@ void make_regions_even(TriangleSurface& s) {
   for (std::size_t c : count) any_odd |= (c % 2 == 1);
   if (!any_odd) return;
 
-  const TriangleTopology topo = build_triangle_topology(s.triangles, s.node_tags.size());
+  std::optional<TriangleTopology> built;
+  const TriangleTopology& topo =
+      s.topology ? *s.topology : built.emplace(build_triangle_topology(s.triangles, s.node_tags.size()));
   // Longest boundary edge per odd region.
   std::vector<std::uint32_t> best_edge(num_regions, kNoTriangle);
   std::vector<double> best_length(num_regions, -1.0);
@@ -214,6 +246,7 @@ void make_regions_even(TriangleSurface& s) {
   }
   Tag next_tag = 1;
   for (Tag t : s.node_tags) next_tag = std::max(next_tag, t + 1);
+  const std::size_t splits_before = s.odd_splits;
   for (std::size_t r = 0; r < num_regions; ++r) {
     if (count[r] % 2 == 0) continue;
     if (best_edge[r] == kNoTriangle) {
@@ -240,6 +273,7 @@ void make_regions_even(TriangleSurface& s) {
     s.input_index.push_back(s.input_index[t]);
     ++s.odd_splits;
   }
+  if (s.odd_splits > splits_before) s.topology.reset();  // after the loop: `topo` may be it
 }
 
 }  // namespace quadval::recombine_detail

@@ -37,6 +37,15 @@ TEST(RecombineInput, DuplicateTriangleIsRejected) {
   EXPECT_NE(e.find("duplicate triangle"), std::string::npos) << e;
 }
 
+// Reversed, and with no third triangle on any edge: no edge is non-manifold.
+TEST(RecombineInput, DuplicateTriangleWithOnlyTwoPerEdgeIsRejected) {
+  const Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}, {0, 1}, {5, 5}, {6, 5}, {5, 6}},
+                                          {{3, 4, 5}, {0, 1, 2}, {2, 1, 0}});
+  const std::string e = error_of(m);
+  EXPECT_NE(e.find("element 3"), std::string::npos) << e;
+  EXPECT_NE(e.find("same three nodes as element 2"), std::string::npos) << e;
+}
+
 TEST(RecombineInput, ZeroAreaTriangleIsRejected) {
   const Mesh m = test::make_triangle_mesh({{0, 0}, {1, 0}, {2, 0}, {1, 1}},
                                           {{0, 1, 3}, {0, 1, 2}});

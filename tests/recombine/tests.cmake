@@ -6,6 +6,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   recombine/smoothing_test.cpp
   recombine/quad_cleanup_test.cpp
   recombine/node_order_test.cpp
+  recombine/triangle_input_test.cpp
   recombine/recombine_test.cpp
   recombine/repair_test.cpp
   recombine/recombine_input_test.cpp
