@@ -39,7 +39,10 @@
 
 #include <algorithm>
 #include <deque>
+#include <exception>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <queue>
 
 #include "quadval/error.hpp"
@@ -123,7 +126,9 @@ class Solver {
     mark_.assign(n, 0);
   }
 
-  bool run() {
+  /// The greedy start and one tree per vertex it leaves free; false when no perfect matching
+  /// can exist (odd count, an isolated vertex). Then finish() solves.
+  bool start() {
     if (n_ % 2 != 0) return false;
     if (!greedy_init()) return false;
     eps_ = 0;
@@ -137,8 +142,11 @@ class Solver {
     }
     free_at_start_ = alive_trees_;
     if (progress_) progress_(0, free_at_start_);
-    return grow_trees();
+    return true;
   }
+  /// false when the graph has no perfect matching.
+  bool finish() { return grow_trees(); }
+  std::uint32_t free_at_start() const { return free_at_start_; }
 
   void read(std::vector<char>& matched) const {
     matched.assign(edges_.size(), 0);
@@ -832,6 +840,9 @@ class Solver {
 struct LocalGraph {
   std::vector<CostEdge> edges;           // renumbered
   std::vector<std::uint32_t> edge_from;  // original index of each renumbered edge
+  // Connected component c holds the vertices [component_start[c], component_start[c + 1])
+  // and, since edges are bucketed by their lower end, a contiguous range of edges too.
+  std::vector<std::uint32_t> component_start;
 };
 LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges) {
   std::vector<std::uint32_t> offsets(std::size_t{n} + 1, 0), adjacent(2 * edges.size());
@@ -850,8 +861,10 @@ LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges)
   constexpr std::uint32_t kUnseen = 0xffffffffu;
   std::vector<std::uint32_t> new_id(n, kUnseen), queue;
   queue.reserve(n);
+  LocalGraph g;
   for (std::uint32_t s = 0; s < n; ++s) {
     if (new_id[s] != kUnseen) continue;
+    g.component_start.push_back(static_cast<std::uint32_t>(queue.size()));
     new_id[s] = static_cast<std::uint32_t>(queue.size());
     queue.push_back(s);
     for (std::size_t head = queue.size() - 1; head < queue.size(); ++head)
@@ -865,7 +878,7 @@ LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges)
   std::fill(offsets.begin(), offsets.end(), 0);
   for (const CostEdge& e : edges) ++offsets[std::min(new_id[e.u], new_id[e.v]) + 1];
   for (std::uint32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
-  LocalGraph g;
+  g.component_start.push_back(n);
   g.edges.resize(edges.size());
   g.edge_from.resize(edges.size());
   for (std::uint32_t i = 0; i < edges.size(); ++i) {
@@ -877,6 +890,37 @@ LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges)
   return g;
 }
 
+// Sums the progress of the chunks' solvers for the caller's callback (MatchingProgress's
+// contract: the second number fixed once every chunk has started).
+class ProgressSum {
+ public:
+  ProgressSum(const MatchingProgress& user, std::size_t chunks) : user_(user), paired_(chunks, 0) {}
+  MatchingProgress of_chunk(std::size_t c) {
+    if (!user_) return {};
+    return [this, c](std::uint32_t paired, std::uint32_t) {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      paired_[c] = paired;
+      if (total_free_ == kUnknown) return;  // chunks still starting
+      std::uint32_t sum = 0;
+      for (std::uint32_t p : paired_) sum += p;
+      user_(sum, total_free_);
+    };
+  }
+  void all_started(std::uint32_t total_free) {
+    if (!user_) return;
+    const std::lock_guard<std::mutex> lock(mutex_);
+    total_free_ = total_free;
+    user_(0, total_free_);
+  }
+
+ private:
+  static constexpr std::uint32_t kUnknown = 0xffffffffu;
+  const MatchingProgress& user_;
+  std::mutex mutex_;
+  std::vector<std::uint32_t> paired_;
+  std::uint32_t total_free_ = kUnknown;
+};
+
 }  // namespace
 
 bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
@@ -887,13 +931,76 @@ bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge
               "edge " << e << " (" << edges[e].u << ", " << edges[e].v << ") in a graph of "
                       << num_nodes);
   const LocalGraph local = breadth_first_order(num_nodes, edges);
-  Solver solver(num_nodes, local.edges, progress);
-  if (!solver.run()) return false;
-  std::vector<char> local_matched;
-  solver.read(local_matched);
+  // Chunks: runs of whole components, each solved by a solver of its own (on the threads
+  // there are): a surface of several faces, as CAD models give, has one component per face.
+  // Small components are grouped, so that a chunk has at least `least` vertices.
+  const std::uint32_t least = std::max<std::uint32_t>(4096, num_nodes / 32);
+  std::vector<std::uint32_t> chunk_start{0};
+  for (std::size_t c = 1; c + 1 < local.component_start.size(); ++c)
+    if (local.component_start[c] - chunk_start.back() >= least) chunk_start.push_back(local.component_start[c]);
+  chunk_start.push_back(num_nodes);
+  const std::size_t chunks = chunk_start.size() - 1;
+  // The edges of chunk k: [edge_start[k], edge_start[k + 1]).
+  std::vector<std::size_t> edge_start(chunks + 1, local.edges.size());
+  for (std::size_t k = 0, e = 0; k < chunks; ++k) {
+    edge_start[k] = e;
+    while (e < local.edges.size() && std::min(local.edges[e].u, local.edges[e].v) < chunk_start[k + 1]) ++e;
+  }
+
+  ProgressSum sum(progress, chunks);
+  std::vector<MatchingProgress> chunk_progress(chunks);
+  std::vector<std::unique_ptr<Solver>> solvers(chunks);
+  std::uint32_t total_free = 0;
+  for (std::size_t k = 0; k < chunks; ++k) {
+    const std::uint32_t first = chunk_start[k];
+    std::vector<CostEdge> part;  // the chunk's edges, renumbered from its first vertex
+    if (chunks > 1) {
+      part.assign(local.edges.begin() + static_cast<std::ptrdiff_t>(edge_start[k]),
+                  local.edges.begin() + static_cast<std::ptrdiff_t>(edge_start[k + 1]));
+      for (CostEdge& e : part) {
+        e.u -= first;
+        e.v -= first;
+      }
+    }
+    chunk_progress[k] = chunks == 1 ? progress : sum.of_chunk(k);
+    solvers[k] = std::make_unique<Solver>(chunk_start[k + 1] - first,
+                                          chunks == 1 ? std::span<const CostEdge>(local.edges) : part,
+                                          chunk_progress[k]);
+    if (!solvers[k]->start()) return false;
+    total_free += solvers[k]->free_at_start();
+  }
+  if (chunks > 1) sum.all_started(total_free);
+
+  // Largest chunks first, so that the threads finish together.
+  std::vector<std::size_t> order(chunks);
+  for (std::size_t k = 0; k < chunks; ++k) order[k] = k;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return chunk_start[a + 1] - chunk_start[a] > chunk_start[b + 1] - chunk_start[b];
+  });
+  std::vector<char> solved(chunks, 0);
+  std::vector<std::exception_ptr> failure(chunks);
+  const auto jobs = static_cast<std::ptrdiff_t>(chunks);
+#pragma omp parallel for schedule(dynamic, 1) if (chunks > 1)
+  for (std::ptrdiff_t i = 0; i < jobs; ++i) {
+    const std::size_t k = order[static_cast<std::size_t>(i)];
+    try {
+      solved[k] = solvers[k]->finish() ? 1 : 0;
+    } catch (...) {
+      failure[k] = std::current_exception();  // an exception may not leave the parallel loop
+    }
+  }
+  for (const std::exception_ptr& f : failure)
+    if (f) std::rethrow_exception(f);
+  if (std::find(solved.begin(), solved.end(), 0) != solved.end()) return false;
+
   matched.assign(edges.size(), 0);
-  for (std::size_t k = 0; k < local_matched.size(); ++k)
-    matched[local.edge_from[k]] = local_matched[k];
+  std::vector<char> part_matched;
+  for (std::size_t k = 0; k < chunks; ++k) {
+    solvers[k]->read(part_matched);
+    for (std::size_t j = 0; j < part_matched.size(); ++j)
+      matched[local.edge_from[edge_start[k] + j]] = part_matched[j];
+    solvers[k].reset();
+  }
   return true;
 }
 

@@ -115,7 +115,11 @@ inline constexpr std::int64_t kMaxMatchingCost = std::int64_t{1} << 46;
 /// start, vertices the start left free): the second stays fixed, the first rises by 2 to it.
 using MatchingProgress = std::function<void(std::uint32_t paired, std::uint32_t free_at_start)>;
 
-/// Minimum-cost perfect matching of the graph (num_nodes, edges).
+/// Minimum-cost perfect matching of the graph (num_nodes, edges). Connected components are
+/// solved by solvers of their own (runs of small components grouped, at least 4,096 vertices
+/// each), largest first, on the OpenMP threads there are; the matching does not depend on
+/// the thread count. A box of 6 faces, Gmsh's Frontal-Delaunay mesh of 128,340 triangles:
+/// 1.20 s in one solver, 0.90 s one solver per face on one thread, 0.43 s on two.
 /// @param[out] matched  #edges flags, 1 for the edges of the matching (resized here)
 /// @param progress      optional (see MatchingProgress)
 /// @return false when the graph has no perfect matching (`matched` is then unspecified)

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include "quadval/io.hpp"
 #include "recombine/blossom_solver.hpp"
@@ -245,6 +246,65 @@ TEST(BlossomSolver, ProgressCountsThePairsUpToTheStartsFreeVertices) {
     EXPECT_EQ(calls[i].second, free);
   }
   EXPECT_EQ(calls.back().first, free);
+}
+
+// Disjoint copies of mesh-like graphs of different sizes, their vertex ids interleaved at
+// random, so that the solver splits the graph into components (chunks of >= 4,096 vertices,
+// solved on their own and on the threads there are; small ones grouped).
+Graph disjoint_union(std::mt19937& rng, const std::vector<int>& sizes, std::int64_t spread) {
+  Graph g;
+  std::vector<Graph> parts;
+  for (int k : sizes) {
+    parts.push_back(mesh_like_graph(rng, k, spread));
+    g.n += parts.back().n;
+  }
+  std::vector<std::uint32_t> id(g.n);
+  for (std::uint32_t i = 0; i < g.n; ++i) id[i] = i;
+  std::shuffle(id.begin(), id.end(), rng);
+  std::uint32_t base = 0;
+  for (const Graph& p : parts) {
+    for (const CostEdge& e : p.edges) g.edges.push_back({id[base + e.u], id[base + e.v], e.cost});
+    base += p.n;
+  }
+  std::shuffle(g.edges.begin(), g.edges.end(), rng);
+  return g;
+}
+
+TEST(BlossomSolver, SolvesDisjointComponentsOnTheirOwnOnAnyThreads) {
+  std::mt19937 rng(13);
+  // 2 * 48^2 = 4,608 and 2 * 60^2 = 7,200 vertices: chunks of their own; the small ones are
+  // grouped with their neighbours in the breadth-first order.
+  const Graph g = disjoint_union(rng, {48, 60, 5, 3, 48, 7}, 1'000'000);
+  bool exists = false;
+  const std::int64_t want = lemon_min(g, exists);
+  ASSERT_TRUE(exists);
+  std::vector<char> one, two;
+  omp_set_num_threads(1);
+  ASSERT_TRUE(min_cost_perfect_matching(g.n, g.edges, one));
+  omp_set_num_threads(2);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> calls;
+  ASSERT_TRUE(min_cost_perfect_matching(
+      g.n, g.edges, two, [&](std::uint32_t paired, std::uint32_t free) { calls.emplace_back(paired, free); }));
+  omp_set_num_threads(omp_get_num_procs());
+  EXPECT_EQ(perfect_cost(g, one), want);
+  EXPECT_EQ(one, two);  // the same matching whatever the threads
+  // The progress contract over all chunks: (0, F) first, then +2 per augmentation up to F.
+  ASSERT_GE(calls.size(), 2u);
+  const std::uint32_t free = calls.front().second;
+  EXPECT_EQ(calls.front().first, 0u);
+  EXPECT_EQ(calls.size(), free / 2 + 1);
+  for (std::size_t i = 1; i < calls.size(); ++i) {
+    EXPECT_EQ(calls[i].first, calls[i - 1].first + 2) << "call " << i;
+    EXPECT_EQ(calls[i].second, free);
+  }
+  // An odd component among even ones: no perfect matching.
+  Graph odd = g;
+  const std::uint32_t extra = odd.n++;
+  odd.edges.push_back({extra, extra + 1, 5});
+  ++odd.n;
+  const std::uint32_t lone = odd.n++;  // joined to nothing but one vertex of the pair above
+  odd.edges.push_back({extra, lone, 5});
+  EXPECT_FALSE(min_cost_perfect_matching(odd.n, odd.edges, one));
 }
 
 TEST(BlossomSolver, ReportsGraphsWithoutPerfectMatching) {
