@@ -29,7 +29,9 @@ Cases: rect-sin-a6 (../shared/data/tri/rect-sin.geo), uniform-N-a6 (unit square,
 about N triangles; N = 10k reproduces uniform-10k-a6.msh's 10,076), uniform-N-a5 (the same
 square triangulated by Gmsh's Delaunay, Mesh.Algorithm 5: fewer equilateral triangles, so
 fewer equal costs; see blossom_solver.hpp for why those matter), disk-N-a5 / disk-N-a6 (a
-disk of diameter 1, about N triangles, Delaunay or Frontal-Delaunay), square-hole-N (Paper I
+disk of diameter 1, about N triangles, Delaunay or Frontal-Delaunay), box-N-a5 / box-N-a6
+(the surface of the unit cube: six faces, as a CAD model has, solved face by face),
+square-hole-N (Paper I
 section 8.1: the construction of scripts/lookahead_square_hole.py, rebuilt here because Gmsh
 needs the geometry). Triangle meshes are cached under /tmp/quadval_recombine_bench/.
 """
@@ -172,6 +174,13 @@ def build_disk(triangles, algorithm):
     uniform_model("disk", lambda: gmsh.model.occ.addDisk(0.5, 0.5, 0, 0.5, 0.5), h, algorithm)
 
 
+def build_box(triangles, algorithm):
+    """The surface of the unit cube, uniform size: six faces, six components of the dual
+    graph, as CAD models give (about 2.3 or 2.65 per face / h^2 triangles, as the square)."""
+    h = ((6 * (2.3 if algorithm == 6 else 2.65)) / triangles) ** 0.5
+    uniform_model("box", lambda: gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1), h, algorithm)
+
+
 def build_square_hole(h_min):
     """Paper I section 8.1: unit square minus the disk of radius 0.15 at (0.75, 0.75),
     h = h_min + 4 h_min min(d / 0.3, 1) with d the distance to the boundary (the same
@@ -244,10 +253,13 @@ def case_builder(name):
         if name.startswith("disk-") and name.endswith(suffix):
             n = parse_count(name[len("disk-"):-len(suffix)])
             return lambda: build_disk(n, algorithm)
+        if name.startswith("box-") and name.endswith(suffix):
+            n = parse_count(name[len("box-"):-len(suffix)])
+            return lambda: build_box(n, algorithm)
     if name.startswith("square-hole-"):
         return square_hole_builder(parse_count(name[len("square-hole-"):]))
     sys.exit(f"unknown case {name!r}: rect-sin-a6, uniform-N-a6, uniform-N-a5, disk-N-a5, "
-             "disk-N-a6, square-hole-N (N like 35k)")
+             "disk-N-a6, box-N-a5, box-N-a6, square-hole-N (N like 35k)")
 
 
 def triangle_mesh(name, build):
