@@ -77,7 +77,14 @@ std::vector<char> region_boundary_nodes(const MixedMesh& m) {
 }
 
 std::vector<std::vector<std::uint32_t>> node_elements(const MixedMesh& m) {
+  // Counted first, so that each list is allocated once (growing them one push at a time took
+  // three or four allocations per node).
+  std::vector<std::uint32_t> count(m.num_nodes(), 0);
+  for (std::size_t e = 0; e < m.elements.size(); ++e)
+    if (m.alive[e])
+      for (int i = 0; i < MixedMesh::size(m.elements[e]); ++i) ++count[m.elements[e][i]];
   std::vector<std::vector<std::uint32_t>> at(m.num_nodes());
+  for (std::size_t v = 0; v < at.size(); ++v) at[v].reserve(count[v]);
   for (std::size_t e = 0; e < m.elements.size(); ++e) {
     if (!m.alive[e]) continue;
     const auto& el = m.elements[e];
