@@ -69,6 +69,7 @@ void order_nodes_along_curve(TriangleSurface& s) {
   s.node_tags = std::move(tags);
   for (auto& t : s.triangles)
     for (NodeIndex& v : t) v = new_index[v];
+  s.topology.reset();  // of the old numbering
 }
 
 void order_triangles_along_curve(TriangleSurface& s) {
@@ -91,6 +92,7 @@ void order_triangles_along_curve(TriangleSurface& s) {
   permute(s.region);
   permute(s.triangle_tags);
   permute(s.input_index);
+  s.topology.reset();  // of the old order
 }
 
 }  // namespace quadval::recombine_detail
