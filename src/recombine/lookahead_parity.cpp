@@ -9,8 +9,7 @@ namespace quadval::recombine_detail {
 
 void make_pieces_even(TriangleSurface& s) {
   std::optional<TriangleTopology> built;
-  const TriangleTopology& topo =
-      s.topology ? *s.topology : built.emplace(build_triangle_topology(s.triangles, s.node_tags.size()));
+  const TriangleTopology& topo = topology_of(s, built);
   const auto n = static_cast<std::uint32_t>(s.triangles.size());
   // Pieces: components over edges shared by two triangles of the same region.
   std::vector<std::int32_t> piece(n, -1);

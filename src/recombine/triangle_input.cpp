@@ -208,6 +208,10 @@ void validate_triangles(TriangleSurface& s, const std::string& source,
     }
 }
 
+const TriangleTopology& topology_of(const TriangleSurface& s, std::optional<TriangleTopology>& built) {
+  return s.topology ? *s.topology : built.emplace(build_triangle_topology(s.triangles, s.node_tags.size()));
+}
+
 TriangleSurface prepare_triangles(const Mesh& mesh, const std::string& source,
                                   std::vector<std::string>& warnings) {
   TriangleSurface s = collect_triangles(mesh, source, warnings);
@@ -224,8 +228,7 @@ void make_regions_even(TriangleSurface& s) {
   if (!any_odd) return;
 
   std::optional<TriangleTopology> built;
-  const TriangleTopology& topo =
-      s.topology ? *s.topology : built.emplace(build_triangle_topology(s.triangles, s.node_tags.size()));
+  const TriangleTopology& topo = topology_of(s, built);
   // Longest boundary edge per odd region.
   std::vector<std::uint32_t> best_edge(num_regions, kNoTriangle);
   std::vector<double> best_length(num_regions, -1.0);

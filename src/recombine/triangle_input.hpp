@@ -51,6 +51,9 @@ TriangleSurface collect_triangles(const Mesh& mesh, const std::string& source,
 void validate_triangles(TriangleSurface& surface, const std::string& source,
                         std::vector<std::string>& warnings);
 
+/// The kept topology of `surface`, or one built into `built` when there is none.
+const TriangleTopology& topology_of(const TriangleSurface& surface, std::optional<TriangleTopology>& built);
+
 /// Splits, in each region with an odd triangle count, its longest boundary edge (an edge with
 /// one triangle in the whole mesh) at the midpoint. Regions without such an edge are listed in
 /// odd_regions_left.
