@@ -47,6 +47,11 @@ class BernsteinProduct {
   void multiply_add(const double* f, const double* g, double scale, double* h) const;
   /// h = f * g.
   void multiply(const double* f, const double* g, double* h) const;
+  /// Four products h_l = f_l * g_l at once, product l in lane l of interleaved vectors
+  /// (coefficient i of f_l at f[4 i + l], likewise g and h), each lane with exactly the
+  /// arithmetic of multiply: the same bits, in one walk over the pairs for all four.
+  /// Returns false, computing nothing, without an entry kernel (large products).
+  bool multiply4(const double* f, const double* g, double* h) const;
   /// One term scale * f * g of a sum of products in the same spaces.
   struct Term {
     double scale;

@@ -6,6 +6,8 @@
 #include <gmpxx.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <map>
 #include <random>
 #include <vector>
@@ -302,6 +304,50 @@ TEST(MuBernsteinProduct, EntryWeightsAreTheExactWeightsRounded) {
         ASSERT_EQ(h[m], nearest_double(want[m])) << "case " << &c - cases.data() << " i " << i << " j " << j;
     }
   }
+}
+
+// multiply4 (four products in the lanes of one walk over the pairs) against multiply on each
+// lane alone: the same bits, signed zeros included, in the spaces the scaled Jacobian's
+// frame products use (simplices, a prism's and a pyramid's tensor spaces) and a few more.
+TEST(MuBernsteinProduct, Multiply4EqualsFourMultipliesBitForBit) {
+  const std::vector<std::pair<std::vector<FactorDegree>, std::vector<FactorDegree>>> cases{
+      {{{3, 2}}, {{3, 2}}}, {{{3, 4}}, {{3, 2}}}, {{{2, 3}}, {{2, 1}}}, {{{1, 5}}, {{1, 0}}},
+      {{{2, 1}, {1, 2}}, {{2, 1}, {1, 2}}}, {{{2, 2}, {1, 4}}, {{2, 2}, {1, 1}}},
+      {{{1, 2}, {1, 2}, {1, 2}}, {{1, 2}, {1, 2}, {1, 2}}}, {{{1, 3}, {1, 3}, {1, 3}}, {{1, 1}, {1, 1}, {1, 1}}}};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const auto& [fd, gd] : cases) {
+    SCOPED_TRACE(::testing::Message() << "f space of " << fd.size() << " factors, degree " << fd[0].degree);
+    const BernsteinProduct& table = bernstein_product(fd, gd);
+    const auto nf = static_cast<std::size_t>(table.f_size()), ng = static_cast<std::size_t>(table.g_size()),
+               nh = static_cast<std::size_t>(table.h_size());
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<double> f(4 * nf), g(4 * ng), h(4 * nh, 1.0);
+      for (double& v : f) v = rng() % 7 == 0 ? (rng() % 2 ? 0.0 : -0.0) : u(rng) * std::ldexp(1.0, static_cast<int>(8 * u(rng)));
+      for (double& v : g) v = rng() % 7 == 0 ? (rng() % 2 ? 0.0 : -0.0) : u(rng) * std::ldexp(1.0, static_cast<int>(8 * u(rng)));
+      ASSERT_TRUE(table.multiply4(f.data(), g.data(), h.data()));
+      for (std::size_t l = 0; l < 4; ++l) {
+        std::vector<double> fl(nf), gl(ng), want(nh);
+        for (std::size_t i = 0; i < nf; ++i) fl[i] = f[4 * i + l];
+        for (std::size_t j = 0; j < ng; ++j) gl[j] = g[4 * j + l];
+        table.multiply(fl.data(), gl.data(), want.data());
+        for (std::size_t k = 0; k < nh; ++k)
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(h[4 * k + l]), std::bit_cast<std::uint64_t>(want[k]))
+              << "lane " << l << " k " << k << ": " << h[4 * k + l] << " vs " << want[k];
+      }
+    }
+  }
+}
+
+// A large product (a quadratic pyramid's second frame product: 125 x 27 pairs) has no entry
+// kernel: multiply4 says so and leaves h alone, and the caller multiplies one lane at a time.
+TEST(MuBernsteinProduct, Multiply4DeclinesLargeProducts) {
+  const BernsteinProduct& table = bernstein_product(std::vector<FactorDegree>{{1, 4}, {1, 4}, {1, 4}},
+                                                    std::vector<FactorDegree>{{1, 2}, {1, 2}, {1, 2}});
+  std::vector<double> f(4 * static_cast<std::size_t>(table.f_size()), 1.0), g(4 * static_cast<std::size_t>(table.g_size()), 1.0);
+  std::vector<double> h(4 * static_cast<std::size_t>(table.h_size()), -7.0);
+  EXPECT_FALSE(table.multiply4(f.data(), g.data(), h.data()));
+  EXPECT_TRUE(std::all_of(h.begin(), h.end(), [](double v) { return v == -7.0; }));
 }
 
 // gram_sums (every entry of W^T W in one walk over the pairs, 8 lanes) against the three-term
