@@ -708,10 +708,10 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
 }
 
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                                     int max_splits) {
+                                     int max_splits, double upper) {
   QualityBounds out;
   out.lower = -kInf;
-  out.upper = 0;  // J <= 0 at a point, where sj <= 0
+  out.upper = std::min(upper, 0.0);  // J <= 0 at a point, where sj <= 0
   if (layout_of(space, in).triple.empty()) return out;  // L_k outside J's space (2D)
   return refine(space, in, tol, max_splits, Pairing::signs, out);
 }

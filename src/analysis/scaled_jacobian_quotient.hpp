@@ -71,11 +71,11 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
                               int max_splits, int max_paired_splits);
 
 /// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D or
-/// planar 2D, with
-/// the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's signs: refined by
-/// at most max_splits best-first splits. Nothing (lower = -inf, upper = 0) where J does not
-/// lie in the space of the product of the columns (none of the 2D and 3D types).
+/// planar 2D, with the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's
+/// signs: refined by at most max_splits best-first splits, from `upper` (a certified upper
+/// bound of sj(E), at most 0). Nothing (lower = -inf, upper) where J does not lie in the
+/// space of the product of the columns (none of the 2D and 3D types).
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                                     int max_splits);
+                                     int max_splits, double upper = 0);
 
 }  // namespace quadval

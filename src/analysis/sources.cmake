@@ -18,6 +18,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/ratio_refinement.cpp
   src/analysis/scaled_jacobian_space.cpp
   src/analysis/scaled_jacobian_quotient.cpp
+  src/analysis/scaled_jacobian_probe.cpp
   src/analysis/bilinear_quad_quality.cpp
   src/analysis/trilinear_hex_sj.cpp
   src/analysis/linear_pyramid_sj.cpp

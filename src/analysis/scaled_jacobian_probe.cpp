@@ -1,0 +1,286 @@
+// A certified upper bound of sj(E) from a local search (scaled_jacobian_probe.hpp).
+#include "analysis/scaled_jacobian_probe.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "analysis/outward_rounding.hpp"
+#include "analysis/sqrt_rn.hpp"
+#include "quadval/bezier_basis.hpp"
+#include "quadval/error.hpp"
+
+namespace quadval {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kFinestStep = 12;  // coordinates stay multiples of 2^-12: 1 - sum is exact
+constexpr int kMaxEvaluations = 400;
+double up(double x) { return next_up(x); }
+
+// One tensor space (J's or a column's): per factor its simplex and multinomials.
+struct Space {
+  std::vector<const BernsteinSimplex*> factors;
+  std::vector<std::vector<double>> multinomial;  // per factor, per coefficient: n! / prod alpha!
+  int size = 1;
+  int roundings = 0;  // of one basis value: sum over factors of n + d + 1, plus the tensor's
+};
+
+Space make_space(const std::vector<FactorDegree>& degrees) {
+  Space s;
+  for (const FactorDegree& fd : degrees) {
+    const BernsteinSimplex& b = bernstein_simplex(fd.dim, fd.degree);
+    s.factors.push_back(&b);
+    std::vector<double> m;
+    for (const auto& alpha : b.multi_indices()) {
+      // n! / prod alpha_a!, built as a product of binomials: exact integers far below 2^53.
+      std::uint64_t v = 1;
+      int taken = 0;
+      for (int a = 0; a <= fd.dim; ++a)
+        for (int k = 1; k <= alpha[static_cast<std::size_t>(a)]; ++k) v = v * static_cast<std::uint64_t>(++taken) / static_cast<std::uint64_t>(k);
+      m.push_back(static_cast<double>(v));
+    }
+    s.multinomial.push_back(std::move(m));
+    s.size *= b.size();
+    s.roundings += fd.degree + fd.dim + 1;
+  }
+  s.roundings += static_cast<int>(degrees.size()) - 1;
+  return s;
+}
+
+// The tensor basis values at point x (the factors' local coordinates, concatenated).
+void basis_at(const Space& s, const double* x, std::vector<double>& out, std::vector<double>& factor_values) {
+  out.assign(1, 1.0);
+  int at = 0;
+  for (std::size_t f = 0; f < s.factors.size(); ++f) {
+    const BernsteinSimplex& b = *s.factors[f];
+    const int d = b.dim(), n = b.degree();
+    std::array<double, 4> lambda{1, 0, 0, 0};
+    for (int c = 0; c < d; ++c) {
+      lambda[static_cast<std::size_t>(c + 1)] = x[at + c];
+      lambda[0] -= x[at + c];  // exact: dyadic coordinates of at most 12 bits
+    }
+    at += d;
+    std::array<std::array<double, 32>, 4> power;  // rows 0..d, entries 0..n set below
+    QV_ASSERT(n < 32, "degree " << n);
+    for (int a = 0; a <= d; ++a) {
+      power[static_cast<std::size_t>(a)][0] = 1;
+      for (int k = 1; k <= n; ++k)
+        power[static_cast<std::size_t>(a)][static_cast<std::size_t>(k)] =
+            power[static_cast<std::size_t>(a)][static_cast<std::size_t>(k - 1)] * lambda[static_cast<std::size_t>(a)];
+    }
+    factor_values.resize(static_cast<std::size_t>(b.size()));
+    const auto alphas = b.multi_indices();
+    for (std::size_t i = 0; i < alphas.size(); ++i) {
+      double v = s.multinomial[f][i];
+      for (int a = 0; a <= d; ++a)
+        v *= power[static_cast<std::size_t>(a)][static_cast<std::size_t>(alphas[i][static_cast<std::size_t>(a)])];
+      factor_values[i] = v;
+    }
+    // Factor f varies slowest so far: out (earlier factors) fastest, as the coefficients.
+    const std::size_t inner = out.size();
+    out.resize(inner * factor_values.size());
+    for (std::size_t i = factor_values.size(); i-- > 0;)
+      for (std::size_t k = 0; k < inner; ++k) out[i * inner + k] = out[k] * factor_values[i];
+  }
+}
+
+double dot(std::span<const double> c, const std::vector<double>& basis) {
+  double sum = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) sum += c[i] * basis[i];
+  return sum;
+}
+
+class Probe {
+ public:
+  Probe(const ScaledJacobianSpace& space, const QuotientInput& in) : space_(space), in_(in) {
+    dim_ = static_cast<std::size_t>(space.dim());
+    j_space_ = make_space(*in.j_degrees);
+    for (std::size_t c = 0; c < dim_; ++c) col_space_[c] = make_space(*in.col_degrees[c]);
+    for (const FactorDegree& fd : *in.j_degrees) factor_dims_.push_back(fd.dim);
+  }
+
+  // sj / s at x in floating point (the search's objective); +inf where no frame has
+  // nonzero column norms.
+  double estimate(const double* x) {
+    evaluate(x);
+    double best = kInf;
+    for (const Frame& fr : space_.frames()) {
+      double norms = 1;
+      for (std::size_t j = 0; j < dim_; ++j) norms *= frame_norm(fr, j);
+      if (norms > 0) best = std::min(best, j_ / norms);
+    }
+    return best;
+  }
+
+  // A certified upper bound of sj(E) at x, or 0 where J < 0 is not certain there.
+  double certified(const double* x) {
+    evaluate(x);
+    const double j_error = up(in_.j_error + up(rounding_gamma(static_cast<int>(in_.j.size()) + j_space_.roundings + 2) *
+                                               largest(in_.j) * 1.01));
+    const double j_hi = up(j_ + j_error);
+    if (!(j_hi < 0)) return 0;
+    std::array<double, 3> col_error{};
+    for (std::size_t c = 0; c < dim_; ++c)
+      col_error[c] = up(in_.col_error[c] + up(rounding_gamma(col_size(c) + col_space_[c].roundings + 2) *
+                                                in_.col_magnitude[c] * 1.01));
+    double upper = 0;
+    for (const Frame& fr : space_.frames()) {
+      double bound = 1;
+      for (std::size_t j = 0; j < dim_; ++j) {
+        // Coordinate error: its columns' errors plus the rounding of their signed sum.
+        double e = 0, magnitude = 0;
+        for (std::size_t c = 0; c < dim_; ++c)
+          if (fr[j][c] != 0) {
+            e += col_error[c];
+            magnitude += in_.col_magnitude[c];
+          }
+        e = up(up(e + rounding_gamma(3) * magnitude) * 1.01);
+        bound = up(bound * up(up(frame_norm(fr, j) * (1 + 1e-12)) + up(up(1.7320508075688772) * e)));
+      }
+      upper = std::min(upper, up(space_.s_lo() * up(j_hi / bound)));
+    }
+    return upper;
+  }
+
+  // Local coordinates x (3 at most) inside the reference domain, every factor's simplex.
+  bool inside(const double* x) const {
+    std::size_t at = 0;
+    for (int d : factor_dims_) {
+      double sum = 0;
+      for (int c = 0; c < d; ++c) {
+        if (x[at + static_cast<std::size_t>(c)] < 0) return false;
+        sum += x[at + static_cast<std::size_t>(c)];
+      }
+      if (sum > 1) return false;
+      at += static_cast<std::size_t>(d);
+    }
+    return true;
+  }
+  const std::vector<int>& factor_dims() const { return factor_dims_; }
+
+ private:
+  static double largest(std::span<const double> c) {
+    double m = 0;
+    for (double v : c) m = std::max(m, std::abs(v));
+    return m;
+  }
+  int col_size(std::size_t c) const { return static_cast<int>(in_.col[c][0].size()); }
+  // |frame column j| from the columns' values at the last evaluated point.
+  double frame_norm(const Frame& fr, std::size_t j) const {
+    double sum = 0;
+    for (std::size_t x = 0; x < 3; ++x) {
+      double v = 0;
+      for (std::size_t c = 0; c < dim_; ++c)
+        if (fr[j][c] != 0) v += fr[j][c] * col_[c][x];
+      sum += v * v;
+    }
+    return sqrt_rn(sum);
+  }
+  void evaluate(const double* x) {
+    basis_at(j_space_, x, basis_, factor_values_);
+    j_ = dot(in_.j, basis_);
+    for (std::size_t c = 0; c < dim_; ++c) {
+      basis_at(col_space_[c], x, basis_, factor_values_);
+      for (std::size_t k = 0; k < 3; ++k) col_[c][k] = dot(in_.col[c][k], basis_);
+    }
+  }
+
+  const ScaledJacobianSpace& space_;
+  const QuotientInput& in_;
+  std::size_t dim_ = 0;
+  Space j_space_;
+  std::array<Space, 3> col_space_;
+  std::vector<int> factor_dims_;
+  std::vector<double> basis_, factor_values_;
+  double j_ = 0;
+  std::array<std::array<double, 3>, 3> col_{};
+};
+
+// The points of the degree-4 lattice of every factor, as a tensor product.
+std::vector<std::array<double, 3>> start_points(const std::vector<int>& dims) {
+  std::vector<std::array<double, 3>> points{{0, 0, 0}};
+  std::size_t at = 0;
+  for (int d : dims) {
+    std::vector<std::array<double, 3>> next;
+    const BernsteinSimplex& lattice = bernstein_simplex(d, 4);
+    for (const auto& p : points)
+      for (const auto& alpha : lattice.multi_indices()) {
+        std::array<double, 3> q = p;
+        for (int c = 0; c < d; ++c) q[at + static_cast<std::size_t>(c)] = alpha[static_cast<std::size_t>(c + 1)] / 4.0;
+        next.push_back(q);
+      }
+    points = std::move(next);
+    at += static_cast<std::size_t>(d);
+  }
+  return points;
+}
+
+}  // namespace
+
+SjProbe probe_scaled_jacobian(const ScaledJacobianSpace& space, const QuotientInput& in, double enough) {
+  Probe probe(space, in);
+  const double target = enough / space.s_hi();  // in the estimates' units, sj / s
+  int evaluations = 0;
+  std::array<double, 3> best{};
+  double best_value = kInf;
+  for (const auto& p : start_points(probe.factor_dims())) {
+    const double v = probe.estimate(p.data());
+    ++evaluations;
+    if (v < best_value) {
+      best_value = v;
+      best = p;
+    }
+  }
+  if (!(best_value < 0)) return {0, best};
+  if (best_value <= target) return {probe.certified(best.data()), best};
+  // Compass search: along each coordinate, and along the edges of each simplex factor of
+  // dimension 2 or 3 (a coordinate traded for another), the best improving move at step
+  // h, else h halves.
+  std::vector<std::array<double, 3>> directions;
+  std::size_t at = 0;
+  for (int d : probe.factor_dims()) {
+    for (int a = 0; a < d; ++a) {
+      std::array<double, 3> e{};
+      e[at + static_cast<std::size_t>(a)] = 1;
+      directions.push_back(e);
+      for (int b = a + 1; b < d; ++b) {
+        std::array<double, 3> t{};
+        t[at + static_cast<std::size_t>(a)] = 1;
+        t[at + static_cast<std::size_t>(b)] = -1;
+        directions.push_back(t);
+      }
+    }
+    at += static_cast<std::size_t>(d);
+  }
+  for (int step = 3; step <= kFinestStep && evaluations < kMaxEvaluations && best_value > target;) {
+    const double h = std::ldexp(1.0, -step);
+    std::array<double, 3> move = best;
+    double move_value = best_value;
+    for (const auto& dir : directions)
+      for (const double sign : {1.0, -1.0}) {
+        std::array<double, 3> q = best;
+        for (std::size_t c = 0; c < 3; ++c) q[c] += sign * h * dir[c];
+        if (!probe.inside(q.data())) continue;
+        const double v = probe.estimate(q.data());
+        ++evaluations;
+        if (v < move_value) {
+          move_value = v;
+          move = q;
+        }
+      }
+    if (move_value < best_value) {
+      best = move;
+      best_value = move_value;
+    } else {
+      ++step;
+    }
+  }
+  return {probe.certified(best.data()), best};
+}
+
+}  // namespace quadval
