@@ -351,6 +351,9 @@ class Quotient {
     const std::vector<int>& j_corners = layout_.j_tools->corners;
     const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
     const std::size_t corners = j_corners.size();
+    // J >= 0 on the whole leaf (every coefficient, its error included): sj >= 0 there, and
+    // no corner has J < 0 to bound sj from above; the columns are not needed.
+    if (down(*std::min_element(leaf, leaf + sj) - err[0]) >= 0) return 0.0;
     const std::uint32_t unusable = directional_columns(leaf, err, false);
     frame_products(unusable);
     double lower = kInf;
