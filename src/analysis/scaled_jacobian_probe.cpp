@@ -142,6 +142,7 @@ class Probe {
         e = up(up(e + rounding_gamma(3) * magnitude) * 1.01);
         bound = up(bound * up(up(frame_norm(fr, j) * (1 + 1e-12)) + up(up(1.7320508075688772) * e)));
       }
+      if (!(bound > 0)) continue;  // (a vanishing column means J = 0 there: not reached)
       upper = std::min(upper, up(space_.s_lo() * up(j_hi / bound)));
     }
     return upper;

@@ -15,12 +15,15 @@
 // a compass search on dyadic points (steps 1/8 down to 1/4096) follows it downhill. The
 // value at the final point is then bounded from above with every rounding accounted for:
 // each coefficient of J and of the columns is within its a priori error of the exact one
-// and the Bernstein basis is nonnegative with sum 1, so the values are too; the basis
-// values themselves are computed within a relative gamma_(n + d + 4) (the multinomial is
-// an exact integer, the barycentric coordinates of a dyadic point exact, each power a
-// product of at most n factors, the tensor product two more), and a sum of N such terms
-// within gamma_(N) of its terms' magnitudes (Higham, §3.1). Only where J is negative
-// there, with all its error, does the point give a bound: s_lo J_hi / prod (|v| + e).
+// and the Bernstein basis is nonnegative with sum 1, so the values are too; a basis value
+// of one simplex factor (dimension d, degree n) is computed within n + d + 1 roundings
+// (the multinomial is an exact integer, the barycentric coordinates of a dyadic point
+// exact, the powers products of at most n factors), a tensor product's within one more per
+// extra factor, and their sum of N terms with the coefficients within gamma_N of its terms'
+// magnitudes (Higham, §3.1): in all within gamma_(N + roundings + 2) of the largest
+// coefficient. A frame column sums at most three columns (two more roundings). Only where J
+// is negative there, with all its error, does the point give a bound:
+// s_lo J_hi / prod (|v| + sqrt(3) e).
 
 #include <array>
 #include <span>
