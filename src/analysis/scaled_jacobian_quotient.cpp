@@ -439,8 +439,9 @@ class Quotient {
   // Per distinct frame column dc of the leaf: ws_.along_of[dc] = its control points' dot
   // products with the unit vector d along their mean, ws_.big[dc] >= their magnitudes,
   // ws_.along_err[dc] >= their errors, and bounds of |v| at the leaf's corners (above:
-  // corner_norm, below: corner_norm_lo) and on the whole leaf (norm_big). With `shifted`
-  // (paired_bound), along_of holds a_i + Q instead, its error and magnitude with it.
+  // corner_norm, for signed_bound; below: corner_norm_lo, with `shifted`) and on the whole
+  // leaf (norm_big). With `shifted` (paired_bound), along_of holds a_i + Q instead, its
+  // error and magnitude with it.
   // Errors: a frame column's coordinates are within e (frame_error), so v . d (|d| <= 1) is
   // within sqrt(3) e plus the dot product's rounding (gamma_3 sum |v_x d_x| <= 4u sqrt(3)
   // max|v_x|). For R: the projection p = V - (V . d) d is computed within 16u |V| (the dot
@@ -476,13 +477,17 @@ class Quotient {
           mag = std::max(mag, std::abs(v));
         }
       const double spread = norm_spread(ev);
+      // Corner norms: from above for the signed bound's corners (J < 0 there), from below
+      // for the paired bound's (J > 0).
       for (std::size_t mi = 0; mi < corners; ++mi) {
         const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
         double sum = 0;
         for (std::size_t x = 0; x < 3; ++x) sum += ws_.part[x * n + at] * ws_.part[x * n + at];
         const double norm = sqrt_rn(sum);
-        ws_.corner_norm[dc * corners + mi] = up(up(norm * (1 + 1e-12)) + spread);
-        ws_.corner_norm_lo[dc * corners + mi] = std::max(0.0, down(down(norm * (1 - 1e-12)) - spread));
+        if (shifted)
+          ws_.corner_norm_lo[dc * corners + mi] = std::max(0.0, down(down(norm * (1 - 1e-12)) - spread));
+        else
+          ws_.corner_norm[dc * corners + mi] = up(up(norm * (1 + 1e-12)) + spread);
       }
       const double len = sqrt_rn(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
       if (!(len > 0) || !(len < kInf)) {
