@@ -547,16 +547,26 @@ QualityBounds scaled_jacobian_bounds(const ElementType& type, std::span<const do
   return scaled_jacobian_bounds_given(type, nodes, options, planar, v);
 }
 
+namespace {
+
+// J and the frame columns of one element from its nodes, for the stages on their own
+// below (tests): the spans point into this thread's storage, valid until its next call.
+QuotientInput element_input(const ScaledJacobianSpace& space, std::span<const double> nodes, bool planar) {
+  thread_local Polys polys;
+  thread_local std::vector<double> values;
+  columns_and_jacobian(space, nodes, planar, polys, values);
+  return quotient_input(polys, static_cast<std::size_t>(space.dim()));
+}
+
+}  // namespace
+
 QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<const double> nodes, bool planar,
                                              double tol, int max_splits) {
   QV_ASSERT(scaled_jacobian_supported(type) && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
             "quotient stage of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
   if (type.dim == 2 && !planar) return {-kInf, space.s_hi(), 0, false};
-  thread_local Polys polys;
-  thread_local std::vector<double> values;
-  columns_and_jacobian(space, nodes, planar, polys, values);
-  return quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits, max_splits);
+  return quotient_bounds(space, element_input(space, nodes, planar), tol, max_splits, max_splits);
 }
 
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
@@ -564,20 +574,14 @@ QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<co
   QV_ASSERT(scaled_jacobian_supported(type) && type.dim >= 2 && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
             "signed stage of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
-  thread_local Polys polys;
-  thread_local std::vector<double> values;
-  columns_and_jacobian(space, nodes, /*planar=*/type.dim == 2, polys, values);
-  return signed_quotient_bounds(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), tol, max_splits);
+  return signed_quotient_bounds(space, element_input(space, nodes, /*planar=*/type.dim == 2), tol, max_splits);
 }
 
 SjProbe scaled_jacobian_probe(const ElementType& type, std::span<const double> nodes, double enough) {
   QV_ASSERT(scaled_jacobian_supported(type) && type.dim >= 2 && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
             "probe of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
-  thread_local Polys polys;
-  thread_local std::vector<double> values;
-  columns_and_jacobian(space, nodes, /*planar=*/type.dim == 2, polys, values);
-  return probe_scaled_jacobian(space, quotient_input(polys, static_cast<std::size_t>(type.dim)), enough);
+  return probe_scaled_jacobian(space, element_input(space, nodes, /*planar=*/type.dim == 2), enough);
 }
 
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,

@@ -179,6 +179,14 @@ inline std::map<Tag, double> read_gmsh_ratios(const std::string& path) {
   return out;
 }
 
+/// The coordinates of element e of block b (#nodes x 3, Gmsh order).
+inline std::vector<double> element_coordinates(const Mesh& mesh, const ElementBlock& b, std::size_t e) {
+  std::vector<double> x;
+  for (NodeIndex n : b.element(e))
+    for (std::size_t j = 0; j < 3; ++j) x.push_back(mesh.coords[3 * static_cast<std::size_t>(n) + j]);
+  return x;
+}
+
 /// A mesh of one block holding these elements (#nodes x 3 coordinates each, Gmsh order),
 /// each with its own nodes; tags 1, 2, ... in order.
 inline Mesh mesh_of_elements(const ElementType& type, const std::vector<std::vector<double>>& elements) {

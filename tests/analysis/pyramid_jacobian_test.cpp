@@ -606,9 +606,7 @@ TEST(PyramidJacobian, GmshWarpedPyramidMeshes) {
     std::map<Tag, std::vector<double>> coords;
     for (const ElementBlock& b : mesh.blocks)
       for (std::size_t e = 0; e < b.size(); ++e) {
-        std::vector<double> x;
-        for (NodeIndex n : b.element(e))
-          for (int j = 0; j < 3; ++j) x.push_back(mesh.coords[3 * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)]);
+        std::vector<double> x = test::element_coordinates(mesh, b, e);
         coords[b.tags[e]] = std::move(x);
       }
     int agree = 0, gmsh_only = 0, checked_exact = 0;

@@ -326,9 +326,7 @@ TEST(ScaledJacobianHighOrder, MeshElementsAroundVanishingColumnsConverge) {
       for (std::size_t e = 0; e < blk.size(); ++e) {
         if (std::find(tags.begin(), tags.end(), blk.tags[e]) == tags.end()) continue;
         SCOPED_TRACE(std::string(name) + " element " + std::to_string(blk.tags[e]));
-        std::vector<double> x;
-        for (NodeIndex n : blk.element(e))
-          for (std::size_t j = 0; j < 3; ++j) x.push_back(mesh.coords[3 * static_cast<std::size_t>(n) + j]);
+        const std::vector<double> x = test::element_coordinates(mesh, blk, e);
         const ElementType& t = *blk.type;
         std::mt19937 rng(5);
         double sampled = INFINITY;

@@ -274,9 +274,7 @@ TEST(ScaledJacobian, FoldedPrismsConvergeQuickly) {
       const Tag tag = b.tags[e];
       if (b.type != &prism || (tag != 107 && tag != 137 && tag != 179 && tag != 209)) continue;
       SCOPED_TRACE(tag);
-      std::vector<double> x;
-      for (NodeIndex n : b.element(e))
-        for (int j = 0; j < 3; ++j) x.push_back(mesh.coords[3 * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)]);
+      const std::vector<double> x = test::element_coordinates(mesh, b, e);
       const QualityBounds q = bounds(prism, x, 1e-2, /*planar=*/false);
       double sampled = INFINITY;
       for (const RefPoint& p : pts) sampled = std::min(sampled, sj_at(prism, x, p, {0, 0, 1}, {1, 0, 0}));
@@ -335,9 +333,7 @@ TEST(ScaledJacobian, FoldedQuadranglesAtTheFloorSettleWithoutSubdivisions) {
       const Tag tag = b.tags[e];
       if (b.type != &quad || (tag != 135 && tag != 139 && tag != 145 && tag != 149)) continue;
       SCOPED_TRACE(tag);
-      std::vector<double> x;
-      for (NodeIndex n : b.element(e))
-        for (int j = 0; j < 3; ++j) x.push_back(mesh.coords[3 * static_cast<std::size_t>(n) + static_cast<std::size_t>(j)]);
+      const std::vector<double> x = test::element_coordinates(mesh, b, e);
       const QualityBounds q = bounds(quad, x, 1e-2);
       EXPECT_LE(q.lower, sampled_min(quad, x, pts) + 1e-12);
       EXPECT_GE(q.upper, -1.0);
