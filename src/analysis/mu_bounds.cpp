@@ -71,25 +71,12 @@ double element_w(const MuSpace& space, std::span<const double> x, double* w) {
     for (int c = 0; c < 3; ++c)
       range = std::max(range, std::abs(x[static_cast<std::size_t>(3 * i + c)] - x[static_cast<std::size_t>(c)]));
   const auto& jinv = space.ideal_inverse();
-  std::fill(w, w + static_cast<std::size_t>(dim * 3) * ws, 0.0);
+  thread_local std::vector<double> dx;  // x_i - x_0
+  dx.resize(3 * static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < dx.size(); ++i) dx[i] = x[i] - x[i % 3];
   for (std::size_t k = 0; k < ws; ++k) {
     double xc[3][3] = {};
-    for (int c = 0; c < dim; ++c) {
-      const double* row = space.derivative(c).data() + k * static_cast<std::size_t>(n);
-      // Sums in scalars: in xc[c][a] GCC 12 stored and reloaded them at every term.
-      double s0 = 0, s1 = 0, s2 = 0;
-      for (int i = 0; i < n; ++i) {
-        const double g = row[i];
-        if (g == 0) continue;
-        const double* xi = x.data() + 3 * static_cast<std::size_t>(i);
-        s0 += g * (xi[0] - x[0]);
-        s1 += g * (xi[1] - x[1]);
-        s2 += g * (xi[2] - x[2]);
-      }
-      xc[c][0] = s0;
-      xc[c][1] = s1;
-      xc[c][2] = s2;
-    }
+    for (int c = 0; c < dim; ++c) space.derivative_nonzeros(c).row_times_points(k, dx.data(), xc[c]);
     for (int j = 0; j < dim; ++j)
       for (int a = 0; a < 3; ++a) {
         double v = 0;

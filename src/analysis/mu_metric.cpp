@@ -111,7 +111,10 @@ void MuMetric::metric_entries(const MuSpace& space, const double* w, double err)
       m.c.assign(static_cast<std::size_t>(p11.h_size()), 0.0);
       out[e] = m.c.data();
     }
-    if (p11.gram_sums(columns, dim, out)) {
+    // Planar elements in a plane z = const: W's z coordinates are +0 everywhere.
+    bool flat_z = true;
+    for (int j = 0; j < dim; ++j) flat_z = flat_z && w_[3 * j + 2].mag == 0;
+    if (p11.gram_sums(columns, dim, out, flat_z ? 2 : 3)) {
       for (int e = 0; e < entries; ++e) {
         const auto [a, b] = entry(e);
         bound_product(p11, {{1.0, &w_[3 * a], &w_[3 * b]}, {1.0, &w_[3 * a + 1], &w_[3 * b + 1]},

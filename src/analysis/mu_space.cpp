@@ -273,6 +273,8 @@ MuSpace::MuSpace(const ElementType& type, TableSource source) : type_(&type) {
   } else {
     init_derivatives();
   }
+  for (std::size_t c = 0; c < static_cast<std::size_t>(dim_); ++c)
+    sparse_[c] = SparseRows::of(deriv_[c], static_cast<std::size_t>(w_basis_->size()), static_cast<std::size_t>(num_nodes_));
 }
 
 MuTables MuSpace::tables() const {

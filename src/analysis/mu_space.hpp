@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analysis/jacobian_product.hpp"
+#include "analysis/sparse_rows.hpp"
 #include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
@@ -91,6 +92,8 @@ class MuSpace {
   const std::vector<double>& derivative(int c) const noexcept { return deriv_[c]; }
   /// max_k sum_i |derivative(c)[k, i]|, rounded up to cover the exact entries.
   double derivative_row_sum(int c) const noexcept { return row_sum_[c]; }
+  /// derivative(c) without its zero entries (sparse_rows.hpp).
+  const SparseRows& derivative_nonzeros(int c) const noexcept { return sparse_[c]; }
 
   /// J_i^-1 (dim x dim, row-major) of the ideal element (mu_bounds.hpp), each entry within
   /// 3u of the exact real number (relative).
@@ -119,6 +122,7 @@ class MuSpace {
   std::vector<FactorDegree> degrees_[13];
   int sizes_[13] = {};
   std::vector<double> deriv_[3];
+  SparseRows sparse_[3];
   double row_sum_[3] = {};
   std::array<double, 9> ideal_inv_{};
   const BernsteinProduct* prod11_ = nullptr;  // (1, 1): the control matrices of M

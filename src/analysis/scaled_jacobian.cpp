@@ -302,6 +302,7 @@ void product_sum(std::initializer_list<ProductTerm> terms, Poly& h) {
     h.deg[i] = {first.f->deg[i].dim, first.f->deg[i].degree + first.g->deg[i].degree};
   h.c.assign(static_cast<std::size_t>(table.h_size()), 0.0);
   double magnitude = 0, propagated = 0;
+  bool zero_everywhere = true;
   std::array<BernsteinProduct::Term, 8> batch{};
   QV_ASSERT(terms.size() <= batch.size(), terms.size() << " terms");
   std::size_t k = 0;
@@ -312,9 +313,12 @@ void product_sum(std::initializer_list<ProductTerm> terms, Poly& h) {
     batch[k++] = {t.scale, f.c.data(), g.c.data()};
     const double sc = std::abs(t.scale);
     magnitude += sc * f.b.m * g.b.m;
+    zero_everywhere = zero_everywhere && (f.b.m == 0 || g.b.m == 0);
     propagated += sc * (f.b.m * g.b.e + (g.b.m + g.b.e) * f.b.e);
   }
-  table.multiply_add_sum(std::span<const BernsteinProduct::Term>(batch.data(), k), h.c.data());
+  // Every term with a factor that is zero everywhere (a planar element's z coordinates in
+  // the cross products): h stays +0, as the kernel would leave it; the error bound is kept.
+  if (!zero_everywhere) table.multiply_add_sum(std::span<const BernsteinProduct::Term>(batch.data(), k), h.c.data());
   refresh_magnitude(h);
   h.b.e = propagated + table.rounding(static_cast<int>(k)) * magnitude;
 }
@@ -423,21 +427,21 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
     }
   auto& col = polys.col;
   for (std::size_t c = 0; c < udim; ++c) {
-    const std::vector<double>& m = space.column_map(static_cast<int>(c));
+    const SparseRows& m = space.column_nonzeros(static_cast<int>(c));
     const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
     const double e = (6 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c)) * range * 1.01;
     for (std::size_t j = 0; j < 3; ++j) {
       Poly& p = col[c][j];
       p.deg = space.column_degrees(static_cast<int>(c));
-      p.c.assign(rows, 0.0);
-      for (std::size_t r = 0; r < rows; ++r) {
-        double sum = 0;
-        for (std::size_t i = 0; i < nn; ++i) sum += m[r * nn + i] * values[i * 3 + j];
-        p.c[r] = sum;
-      }
-      refresh_magnitude(p);
+      p.c.resize(rows);
       p.b.e = e;
     }
+    for (std::size_t r = 0; r < rows; ++r) {
+      double sum[3];
+      m.row_times_points(r, values.data(), sum);
+      for (std::size_t j = 0; j < 3; ++j) col[c][j].c[r] = sum[j];
+    }
+    for (std::size_t j = 0; j < 3; ++j) refresh_magnitude(col[c][j]);
   }
 
   // 2a. J by Bernstein products (w = the cross product of the first two columns in 2D, of

@@ -178,6 +178,7 @@ ScaledJacobianSpace::ScaledJacobianSpace(const ElementType& type)
     col_map_[uc].resize(rows * nn);
     for (std::size_t r = 0; r < rows; ++r)
       for (std::size_t i = 0; i < nn; ++i) col_map_[uc][r * nn + i] = g[r * nn + i] * inv[r];
+    col_sparse_[uc] = SparseRows::of(col_map_[uc], rows, nn);
     // Covers sum_i |exact G_ki| (the product path's own bound).
     col_row_sum_[uc] = curved.row_sum[uc];
   }
@@ -211,6 +212,7 @@ void ScaledJacobianSpace::init_pyramid() {
     QV_ASSERT(maps.map[c].size() == static_cast<std::size_t>(col_size_[c] * type_->num_nodes),
               "pyramid column map of " << type_->name);
     col_map_[c] = std::move(maps.map[c]);
+    col_sparse_[c] = SparseRows::of(col_map_[c], static_cast<std::size_t>(col_size_[c]), static_cast<std::size_t>(type_->num_nodes));
     col_row_sum_[c] = next_up(maps.row_sum[c]);
   }
   // At the ideal pyramid each corner frame has |V| / prod |v_j| = 1 / sqrt 2.

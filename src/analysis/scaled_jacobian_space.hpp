@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "analysis/jacobian_space.hpp"
+#include "analysis/sparse_rows.hpp"
 #include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "quadval/bezier_basis.hpp"
@@ -59,6 +60,8 @@ class ScaledJacobianSpace {
   /// (the Jacobian product path's scaled derivative map times its rounded 1 / mult(k);
   /// pyramids: pyramid_column_maps, within u).
   const std::vector<double>& column_map(int c) const noexcept { return col_map_[static_cast<std::size_t>(c)]; }
+  /// column_map(c) without its zero entries (sparse_rows.hpp).
+  const SparseRows& column_nonzeros(int c) const noexcept { return col_sparse_[static_cast<std::size_t>(c)]; }
   /// max over rows of sum_i |exact entry|, rounded up.
   double column_row_sum(int c) const noexcept { return col_row_sum_[static_cast<std::size_t>(c)]; }
 
@@ -72,6 +75,7 @@ class ScaledJacobianSpace {
   std::array<std::vector<FactorDegree>, 3> col_degrees_;
   std::array<int, 3> col_size_{0, 0, 0};
   std::array<std::vector<double>, 3> col_map_;
+  std::array<SparseRows, 3> col_sparse_;
   std::array<double, 3> col_row_sum_{0, 0, 0};
   double s_lo_ = 1, s_hi_ = 1;
 };

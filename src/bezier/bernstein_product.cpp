@@ -486,47 +486,54 @@ void BernsteinProduct::fused_entries(std::span<const Term> terms, const std::vec
   }
 }
 
-template <int Columns>
+template <int Columns, int Coordinates>
 void BernsteinProduct::gram_entries(const double* const* w, double* const* h) const {
   // Lane e of a pair's sum is entry e's sum_x w[3 a_e + x](i) w[3 b_e + x](j): per
-  // coefficient, its values laid out once as the 3 vectors (x = 0, 1, 2) of the a_e side
-  // and the 3 of the b_e side, so that a pair costs three vector products and three sums.
+  // coefficient, its values laid out once as the vectors (x = 0, 1, 2) of the a_e side
+  // and those of the b_e side, so that a pair costs three vector products and three sums.
   typedef double V8 __attribute__((vector_size(64)));
   constexpr std::size_t kEntries = Columns * (Columns + 1) / 2;
+  constexpr std::size_t kX = Coordinates;
   const auto entry = [](std::size_t e) { return Columns == 3 ? kGramEntries3[e] : kGramEntries2[e % 3]; };
   thread_local std::vector<V8> side_a, side_b;
   const auto n = static_cast<std::size_t>(f_size_);
-  side_a.assign(3 * n, V8{});
-  side_b.assign(3 * n, V8{});
+  side_a.assign(kX * n, V8{});
+  side_b.assign(kX * n, V8{});
   for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t x = 0; x < 3; ++x)
+    for (std::size_t x = 0; x < kX; ++x)
       for (std::size_t e = 0; e < kEntries; ++e) {
-        side_a[3 * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[0]) + x][i];
-        side_b[3 * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[1]) + x][i];
+        side_a[kX * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[0]) + x][i];
+        side_b[kX * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[1]) + x][i];
       }
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
     V8 acc{};
     for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
-      const V8* x = side_a.data() + 3 * static_cast<std::size_t>(pairs[p].i);
-      const V8* y = side_b.data() + 3 * static_cast<std::size_t>(pairs[p].j);
+      const V8* x = side_a.data() + kX * static_cast<std::size_t>(pairs[p].i);
+      const V8* y = side_b.data() + kX * static_cast<std::size_t>(pairs[p].j);
       // As fused_entries<3> with scales 1 (exact): the same roundings in the same order.
-      const V8 sum = x[0] * y[0] + x[1] * y[1] + x[2] * y[2];
+      V8 sum = x[0] * y[0] + x[1] * y[1];
+      if constexpr (kX == 3) sum = sum + x[2] * y[2];
       acc += pairs[p].w * sum;
     }
     for (std::size_t e = 0; e < kEntries; ++e) h[e][k] += acc[e];
   }
 }
 
-bool BernsteinProduct::gram_sums(const double* const* w, int columns, double* const* h) const {
+bool BernsteinProduct::gram_sums(const double* const* w, int columns, double* const* h, int coordinates) const {
   QV_ASSERT(std::equal(f_degrees_.begin(), f_degrees_.end(), g_degrees_.begin(), g_degrees_.end(),
                        [](const FactorDegree& a, const FactorDegree& b) { return a.dim == b.dim && a.degree == b.degree; }),
             "Gram sums of a product of two spaces");
+  QV_ASSERT(coordinates == 2 || coordinates == 3, coordinates << " coordinates");
   if (!entries_kernel_ || pairs_.empty()) return false;
-  if (columns == 3)
-    gram_entries<3>(w, h);
+  if (columns == 3 && coordinates == 3)
+    gram_entries<3, 3>(w, h);
+  else if (columns == 3)
+    gram_entries<3, 2>(w, h);
+  else if (columns == 2 && coordinates == 3)
+    gram_entries<2, 3>(w, h);
   else if (columns == 2)
-    gram_entries<2>(w, h);
+    gram_entries<2, 2>(w, h);
   else
     return false;
   return true;

@@ -69,8 +69,10 @@ class BernsteinProduct {
   /// the arithmetic of multiply_add_sum on its three terms (scales 1) by the general pairs,
   /// so rounding(3) bounds each, in the order of kGramEntries3 (kGramEntries2 for 2
   /// columns). Returns false, adding nothing, without an entry kernel
-  /// (large products): then one multiply_add_sum per entry.
-  bool gram_sums(const double* const* w, int columns, double* const* h) const;
+  /// (large products): then one multiply_add_sum per entry. With coordinates = 2 the sums
+  /// leave out x = 2 (w[3 a + 2] is not read): the same bits as 3 where that coordinate is
+  /// +0 everywhere (a planar element's z: its products add zeros to sums that start at +0).
+  bool gram_sums(const double* const* w, int columns, double* const* h, int coordinates = 3) const;
   /// gram_sums' entries (a, b), in order: 3 columns, then 2.
   static constexpr std::array<std::array<int, 2>, 6> kGramEntries3{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
   static constexpr std::array<std::array<int, 2>, 3> kGramEntries2{{{0, 0}, {1, 1}, {0, 1}}};
@@ -110,8 +112,8 @@ class BernsteinProduct {
   template <std::size_t N>
   void fused_entries(std::span<const Term> terms, const std::vector<int>& row_start,
                      const std::vector<Pair>& pair_list, double* h) const;
-  // gram_sums for 2 or 3 columns.
-  template <int Columns>
+  // gram_sums for 2 or 3 columns, of 2 or 3 coordinates.
+  template <int Columns, int Coordinates>
   void gram_entries(const double* const* w, double* const* h) const;
   // The same product as a dense convolution: coefficients scaled by their multinomials on
   // a grid of the barycentric indices (alpha_1..alpha_d of each factor, concatenated; at

@@ -355,6 +355,44 @@ TEST(MuBernsteinProduct, Multiply4DeclinesLargeProducts) {
 // roundings in the same order (diagonal entries through two copies of the column, so that
 // multiply_add_sum does not take its rows of squares). Also, against exact rationals,
 // within rounding(3).
+// gram_sums over two coordinates (planar elements: W's z coordinates are +0 everywhere)
+// against the same sums over three with that coordinate +0: bit for bit, for every space,
+// column count and entry.
+TEST(MuBernsteinProduct, GramSumsOfTwoCoordinatesEqualThreeWithZeroZ) {
+  const std::vector<std::vector<FactorDegree>> spaces{{{2, 1}}, {{2, 3}}, {{1, 2}, {1, 2}}, {{3, 2}}, {{2, 2}, {1, 2}}};
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const auto& d : spaces)
+    for (const int columns : {2, 3}) {
+      SCOPED_TRACE(::testing::Message() << "space " << &d - spaces.data() << ", " << columns << " columns");
+      const BernsteinProduct& table = bernstein_product(d, d);
+      const auto n = static_cast<std::size_t>(table.f_size());
+      std::vector<std::vector<double>> w(static_cast<std::size_t>(3 * columns), std::vector<double>(n));
+      for (std::size_t c = 0; c < w.size(); ++c)
+        for (double& v : w[c]) v = c % 3 == 2 ? 0.0 : u(rng) * std::ldexp(1.0, static_cast<int>(4 * u(rng)));
+      const double* cols[9];
+      for (int c = 0; c < 3 * columns; ++c) cols[c] = w[static_cast<std::size_t>(c)].data();
+      std::vector<std::vector<double>> three(6, std::vector<double>(static_cast<std::size_t>(table.h_size()), 0.0));
+      std::vector<std::vector<double>> two = three;
+      double* out3[6];
+      double* out2[6];
+      for (std::size_t e = 0; e < 6; ++e) out3[e] = three[e].data(), out2[e] = two[e].data();
+      ASSERT_TRUE(table.gram_sums(cols, columns, out3, 3));
+      ASSERT_TRUE(table.gram_sums(cols, columns, out2, 2));
+      for (std::size_t e = 0; e < 6; ++e)
+        for (std::size_t k = 0; k < three[e].size(); ++k) {
+          ASSERT_EQ(std::signbit(two[e][k]), std::signbit(three[e][k])) << "entry " << e << " k " << k;
+          ASSERT_EQ(two[e][k], three[e][k]) << "entry " << e << " k " << k;
+        }
+      // And a nonzero z is left out: the sums differ somewhere.
+      for (double& v : w[2]) v = 1;
+      std::vector<std::vector<double>> with_z(6, std::vector<double>(static_cast<std::size_t>(table.h_size()), 0.0));
+      for (std::size_t e = 0; e < 6; ++e) out3[e] = with_z[e].data();
+      ASSERT_TRUE(table.gram_sums(cols, columns, out3, 3));
+      EXPECT_NE(with_z[0], two[0]);
+    }
+}
+
 TEST(MuBernsteinProduct, GramSumsEqualThreeTermSumsBitForBit) {
   const std::vector<std::vector<FactorDegree>> spaces{{{3, 2}}, {{2, 3}}, {{1, 2}, {1, 2}, {1, 2}}, {{2, 2}, {1, 2}}};
   std::mt19937 rng(5);
