@@ -66,17 +66,27 @@ double element_w(const MuSpace& space, std::span<const double> x, double* w) {
   const int dim = space.dim();
   const int n = space.num_nodes();
   const auto ws = static_cast<std::size_t>(space.w_size());
-  double range = 0;
-  for (int i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-      range = std::max(range, std::abs(x[static_cast<std::size_t>(3 * i + c)] - x[static_cast<std::size_t>(c)]));
   const auto& jinv = space.ideal_inverse();
   thread_local std::vector<double> dx;  // x_i - x_0
   dx.resize(3 * static_cast<std::size_t>(n));
-  for (std::size_t i = 0; i < dx.size(); ++i) dx[i] = x[i] - x[i % 3];
+  double range = 0;
+  bool flat_z = true;  // a planar element in z = const
+  for (std::size_t i = 0; i < dx.size(); i += 3) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      dx[i + c] = x[i + c] - x[c];
+      range = std::max(range, std::abs(dx[i + c]));
+    }
+    flat_z = flat_z && dx[i + 2] == 0;
+  }
   for (std::size_t k = 0; k < ws; ++k) {
     double xc[3][3] = {};
-    for (int c = 0; c < dim; ++c) space.derivative_nonzeros(c).row_times_points(k, dx.data(), xc[c]);
+    for (int c = 0; c < dim; ++c) {
+      const SparseRows& map = space.derivative_nonzeros(c);
+      if (flat_z)
+        map.row_times_flat_points(k, dx.data(), xc[c]);
+      else
+        map.row_times_points(k, dx.data(), xc[c]);
+    }
     for (int j = 0; j < dim; ++j)
       for (int a = 0; a < 3; ++a) {
         double v = 0;

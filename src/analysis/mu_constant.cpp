@@ -125,10 +125,11 @@ double constant_w_radius(const MuSpace& space, const double* w, double err) {
   double dev = 0;
   for (int j = 0; j < space.dim() * 3; ++j) {
     const double* p = w + static_cast<std::size_t>(j) * ws;
-    // |w_k - w_0| rounded to nearest is within one ulp: next_up covers it.
-    for (std::size_t k = 1; k < ws; ++k) dev = std::max(dev, next_up(std::abs(p[k] - p[0])));
+    for (std::size_t k = 1; k < ws; ++k) dev = std::max(dev, std::abs(p[k] - p[0]));
   }
-  return next_up(err + dev);
+  // |w_k - w_0| rounded to nearest is within one ulp: next_up covers it (next_up of the
+  // largest is the largest next_up, next_up being monotone).
+  return next_up(err + next_up(dev));
 }
 
 double constant_ratio_lower(const MuSpace& space, const double* w, double delta, double* eigenvectors) {

@@ -600,8 +600,10 @@ double corner_ratio_upper(const MuSpace& space, const double* w, double err,
     const double estimate = corner_estimate(cm, dim);
     corners.push_back({k, std::isnan(estimate) ? -1.0 : estimate, cm});
   }
-  std::stable_sort(corners.begin(), corners.end(),
-                   [](const Corner& a, const Corner& b) { return a.estimate < b.estimate; });
+  // Stable insertion sort (std::stable_sort's order): a few corners, no buffer.
+  for (std::size_t i = 1; i < corners.size(); ++i)
+    for (std::size_t j = i; j > 0 && corners[j].estimate < corners[j - 1].estimate; --j)
+      std::swap(corners[j], corners[j - 1]);
   double best = below;
   for (const Corner& c : corners) {
     if (best < 1 && (dim == 2 ? ratio_at_least2(c.metric.m.data(), c.metric.err, best)
