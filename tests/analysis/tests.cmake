@@ -32,4 +32,5 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/check_stream_test.cpp
   analysis/distortion_refine_test.cpp
   analysis/product_tables_test.cpp
+  analysis/sparse_rows_test.cpp
 )
