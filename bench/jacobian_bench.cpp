@@ -254,6 +254,26 @@ void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
                                                     benchmark::Counter::kIsIterationInvariantRate);
 }
 
+// The same on a plate of curved, valid elements throughout, made (and cached under
+// /tmp/quadval_check_bench/) by `bench/compare_gmsh_check.py --plate tri:0.05 quad:0.08`:
+// 51,205 quartic triangles, 10,030 quadratic quadrangles. Skipped until it exists.
+void BM_CheckPlateQuality(benchmark::State& state, const std::string& name) {
+  Mesh mesh;
+  try {
+    mesh = read_mesh("/tmp/quadval_check_bench/" + name + ".msh");
+  } catch (const std::exception& e) {
+    state.SkipWithError((std::string(e.what()) + " (made by bench/compare_gmsh_check.py --plate)").c_str());
+    return;
+  }
+  CheckOptions o;
+  o.threads = 1;
+  o.measure = state.range(0) == 0 ? CheckMeasure::mu : CheckMeasure::scaled_jacobian;
+  for (auto _ : state)
+    benchmark::DoNotOptimize(check_mesh_streamed(mesh, o, name, {}));
+  state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
+                                                    benchmark::Counter::kIsIterationInvariantRate);
+}
+
 // The product kernel alone (jacobian_coefficients: nodes -> Bézier coefficients of J and
 // their error bounds) over the first block of a shared mesh, in chunks of 64 as `check`
 // calls it; the nodes are gathered once, outside the timing.
@@ -301,6 +321,12 @@ const bool kSharedCurvedRegistered = [] {
         ->Arg(0)
         ->Arg(1)
         ->Unit(benchmark::kMicrosecond);
+  for (const char* name : {"plate_tri_h0.05", "plate_quad_h0.08"})
+    benchmark::RegisterBenchmark((std::string("BM_CheckPlateQuality/") + name).c_str(),
+                                 [name](benchmark::State& s) { BM_CheckPlateQuality(s, name); })
+        ->Arg(0)
+        ->Arg(1)
+        ->Unit(benchmark::kMillisecond);
   for (const char* name : {"quad_h0.4_o2", "tets_h0.8_o2", "tri_h0.4_o4", "warped_hexahedron_o2_N6_a0.25",
                            "warped_prism_o2_N6_a0.25", "warped_tetrahedron_o3_N6_a0.25"})
     benchmark::RegisterBenchmark((std::string("BM_JacobianProductKernel/") + name).c_str(),
