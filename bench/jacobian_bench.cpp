@@ -240,11 +240,9 @@ void BM_CheckSharedCurved(benchmark::State& state, const std::string& name) {
                                                     benchmark::Counter::kIsIterationInvariantRate);
 }
 
-// The quality measures of `check` (mu, the scaled Jacobian; validity included) on a shared
-// mesh, one thread, at the CLI's default tolerance: Arg 0 mu, 1 the scaled Jacobian.
-void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
-  Mesh mesh;
-  if (!read_shared_curved(state, name, mesh)) return;
+// The quality measures of `check` (mu, the scaled Jacobian; validity included) on a mesh,
+// one thread, at the CLI's default tolerance: Arg 0 mu, 1 the scaled Jacobian.
+void check_quality(benchmark::State& state, const Mesh& mesh, const std::string& name) {
   CheckOptions o;
   o.threads = 1;
   o.measure = state.range(0) == 0 ? CheckMeasure::mu : CheckMeasure::scaled_jacobian;
@@ -252,6 +250,12 @@ void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
     benchmark::DoNotOptimize(check_mesh_streamed(mesh, o, name, {}));
   state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
                                                     benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// On a shared mesh.
+void BM_CheckSharedQuality(benchmark::State& state, const std::string& name) {
+  Mesh mesh;
+  if (read_shared_curved(state, name, mesh)) check_quality(state, mesh, name);
 }
 
 // The same on a plate of curved, valid elements throughout, made (and cached under
@@ -265,13 +269,7 @@ void BM_CheckPlateQuality(benchmark::State& state, const std::string& name) {
     state.SkipWithError((std::string(e.what()) + " (made by bench/compare_gmsh_check.py --plate)").c_str());
     return;
   }
-  CheckOptions o;
-  o.threads = 1;
-  o.measure = state.range(0) == 0 ? CheckMeasure::mu : CheckMeasure::scaled_jacobian;
-  for (auto _ : state)
-    benchmark::DoNotOptimize(check_mesh_streamed(mesh, o, name, {}));
-  state.counters["elements/s"] = benchmark::Counter(static_cast<double>(mesh.num_elements()),
-                                                    benchmark::Counter::kIsIterationInvariantRate);
+  check_quality(state, mesh, name);
 }
 
 // The product kernel alone (jacobian_coefficients: nodes -> Bézier coefficients of J and

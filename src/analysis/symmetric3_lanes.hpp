@@ -43,7 +43,11 @@ Lanes<W> up(Lanes<W> x) {
   constexpr std::int64_t kMagnitude = 0x7fffffffffffffff, kInfBits = 0x7ff0000000000000;
   const Mask<W> b = std::bit_cast<Mask<W>>(x);
   const Mask<W> mag = b & kMagnitude;
-  Mask<W> r = b < 0 ? b - 1 : b + 1;
+  // b - 1 or b + 1 in unsigned lanes: -0's b - 1 (and a NaN's b + 1) would overflow as
+  // signed, in lanes the selects below discard.
+  typedef std::uint64_t Bits __attribute__((vector_size(8 * W)));
+  const Mask<W> step = b < 0 ? Mask<W>{} - 1 : Mask<W>{} + 1;
+  Mask<W> r = std::bit_cast<Mask<W>>(std::bit_cast<Bits>(b) + std::bit_cast<Bits>(step));
   r = mag == 0 ? Mask<W>{} + 1 : r;
   r = (mag > kInfBits) | (b == kInfBits) ? b : r;
   return std::bit_cast<Lanes<W>>(r);
