@@ -489,8 +489,8 @@ void BernsteinProduct::fused_entries(std::span<const Term> terms, const std::vec
 template <int Columns, int Coordinates>
 void BernsteinProduct::gram_entries(const double* const* w, double* const* h) const {
   // Lane e of a pair's sum is entry e's sum_x w[3 a_e + x](i) w[3 b_e + x](j): per
-  // coefficient, its values laid out once as the vectors (x = 0, 1, 2) of the a_e side
-  // and those of the b_e side, so that a pair costs three vector products and three sums.
+  // coefficient, its values laid out once as the vectors (x < Coordinates) of the a_e side
+  // and those of the b_e side, so that a pair costs a vector product and a sum per x.
   typedef double V8 __attribute__((vector_size(64)));
   constexpr std::size_t kEntries = Columns * (Columns + 1) / 2;
   constexpr std::size_t kX = Coordinates;

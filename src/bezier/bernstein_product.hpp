@@ -71,7 +71,8 @@ class BernsteinProduct {
   /// columns). Returns false, adding nothing, without an entry kernel
   /// (large products): then one multiply_add_sum per entry. With coordinates = 2 the sums
   /// leave out x = 2 (w[3 a + 2] is not read): the same bits as 3 where that coordinate is
-  /// +0 everywhere (a planar element's z: its products add zeros to sums that start at +0).
+  /// zero everywhere (a planar element's z), as its products, +-0, change a pair's sum at
+  /// most in the sign of a zero, which the row's sum from +0 then drops.
   bool gram_sums(const double* const* w, int columns, double* const* h, int coordinates = 3) const;
   /// gram_sums' entries (a, b), in order: 3 columns, then 2.
   static constexpr std::array<std::array<int, 2>, 6> kGramEntries3{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
