@@ -600,18 +600,7 @@ void JacobianProduct::build_sparse_rows() {
     const auto n = static_cast<std::size_t>(map.num_nodes);
     for (int c = 0; c < dim_; ++c) {
       const auto cs = static_cast<std::size_t>(c);
-      SparseRows& r = map.rows[cs];
-      r = SparseRows{};
-      r.first.push_back(0);
-      const auto rows = static_cast<std::size_t>(deriv_space_[cs].total);
-      for (std::size_t k = 0; k < rows; ++k) {
-        for (std::size_t i = 0; i < n; ++i)
-          if (const double w = map.matrix[cs][k * n + i]; w != 0) {
-            r.node.push_back(static_cast<int>(i));
-            r.weight.push_back(w);
-          }
-        r.first.push_back(static_cast<int>(r.node.size()));
-      }
+      map.rows[cs] = SparseRows::of(map.matrix[cs], static_cast<std::size_t>(deriv_space_[cs].total), n);
     }
   }
 }
@@ -677,9 +666,9 @@ void JacobianProduct::lane_block(const Map& map, const double* nodes, std::size_
       for (std::size_t k = 0; k < rows; ++k) {
         const double inv = deriv_inv_mult_[cs][k];
         double acc[kAxes][W] = {};
-        for (int t = r.first[k]; t < r.first[k + 1]; ++t) {
-          const double g = r.weight[static_cast<std::size_t>(t)];
-          const double* xi = x + static_cast<std::size_t>(r.node[static_cast<std::size_t>(t)]) * 3 * w;
+        for (std::uint32_t t = r.start[k]; t < r.start[k + 1]; ++t) {
+          const double g = r.value[t];
+          const double* xi = x + static_cast<std::size_t>(r.node[t]) * 3 * w;
           for (std::size_t j = 0; j < kAxes; ++j) {
             #pragma omp simd
             for (std::size_t l = 0; l < w; ++l) acc[j][l] += g * xi[j * w + l];

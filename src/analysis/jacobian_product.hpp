@@ -26,6 +26,7 @@
 #include <mutex>
 #include <vector>
 
+#include "analysis/sparse_rows.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
 
@@ -130,14 +131,9 @@ class JacobianProduct {
     std::vector<int> first;  // outputs + 1 offsets into terms
     std::vector<std::array<int, 2>> terms;  // (input a, input b)
   };
-  struct SparseRows {  // nonzero entries of a derivative map, row by row in column order
-    std::vector<int> first;  // rows + 1 offsets
-    std::vector<int> node;
-    std::vector<double> weight;
-  };
   struct Map {
     int num_nodes = 0;
-    std::array<SparseRows, 3> rows;  // matrix without its zeros, what the kernel reads
+    std::array<SparseRows, 3> rows;  // matrix without its zeros (sparse_rows.hpp), what the kernel reads
     // derivative maps: deriv[c] is rows(c) x num_nodes, row-major, scaled rows
     std::array<std::vector<double>, 3> matrix;
     std::array<double, 3> row_sum{0, 0, 0};  // max_k sum_i |exact entry| / mult(k), rounded up

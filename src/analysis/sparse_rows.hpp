@@ -1,7 +1,7 @@
 #pragma once
 // A dense row-major map without its zero entries, row by row in the same order, for the
-// per-element maps from node coordinates to Bézier coefficients (mu_space.hpp,
-// scaled_jacobian_space.hpp): the same terms summed in the same order as over the dense
+// per-element maps from node coordinates to Bézier coefficients (jacobian_product.hpp,
+// mu_space.hpp, scaled_jacobian_space.hpp): the same terms summed in the same order as over the dense
 // row, so the same result bit for bit (a zero entry times a finite difference adds a
 // zero, which leaves a sum started at +0 unchanged), without a multiply or a test per zero.
 // Between 27% (quadratic hexahedra) and 64% (quartic triangles) of the entries are nonzero.
