@@ -372,7 +372,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
     std::vector<QualityBounds> lane_mu;
-    unsigned lane_mu_done[kLinearChunk / 8];
+    unsigned lane_mu_done[kLinearChunk / kNativeLanes];
     const Buffer own = batched ? Buffer{} : make_buffer(kFastChunk);  // the largest chunk
     for (;;) {
       const std::size_t claimed = next_chunk.fetch_add(1, std::memory_order_relaxed);
@@ -459,15 +459,16 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             };
             // mu of a chunk's valid straight-sided tetrahedra (decided by linear_validity_chunk,
             // vertices in `soa` by vertex and axis, rows of `row`; betas: the straight-sided
-            // margins of the columns, 3 per element, or none for first-order ones), 8 at a
-            // time (straight_tet_mu.hpp): bit i % 8 of lane_mu_done[i / 8] set where
+            // margins of the columns, 3 per element, or none for first-order ones), kNativeLanes
+            // at a time (straight_tet_mu.hpp): bit i % W of lane_mu_done[i / W] set where
             // lane_mu[i] holds element i's, as mu_bounds_given would compute it.
             const auto tet_mu_lanes = [&](const ElementType& t, std::size_t row, const double* betas, std::size_t count) {
               lane_mu.resize(kLinearChunk);
-              for (std::size_t i0 = 0; i0 < count; i0 += 8) {
-                Lanes<8> edges[9], margin[3] = {};
+              constexpr std::size_t kW = kNativeLanes;
+              for (std::size_t i0 = 0; i0 < count; i0 += kW) {
+                Lanes<kW> edges[9], margin[3] = {};
                 unsigned valid = 0;
-                for (std::size_t l = 0; l < 8; ++l) {
+                for (std::size_t l = 0; l < kW; ++l) {
                   const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
                   for (std::size_t v = 0; v < 9; ++v)  // vertex v / 3 + 1 minus vertex 0, axis v % 3
                     edges[v][l] = soa[(3 + v) * row + i] - soa[(v % 3) * row + i];
@@ -476,12 +477,12 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                       (!betas || std::isfinite(margins[i])))
                     valid |= 1u << l;
                 }
-                lane_mu_done[i0 / 8] =
+                lane_mu_done[i0 / kW] =
                     valid != 0 ? valid & straight_tet_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0) : 0u;
               }
             };
             const auto lane_mu_of = [&](std::size_t i) {
-              return ((lane_mu_done[i / 8] >> (i % 8)) & 1u) != 0 ? &lane_mu[i] : nullptr;
+              return ((lane_mu_done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane_mu[i] : nullptr;
             };
             // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp),
             // which never takes the exact fallback: the bookkeeping, and mu and the scaled

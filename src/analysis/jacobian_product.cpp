@@ -14,7 +14,7 @@
 //   input errors: sum_perm (delta_a B C + A delta_b C + A B delta_c), the same in 2D with
 //     |n_i| in place of one factor, and in 1D sum_j |t_j| delta_j.
 // Each bound is multiplied by 1.01, which covers the rounding of the bound itself.
-// The kernel (lane_block) computes 8 elements per SIMD lane block but, per element, the
+// The kernel (lane_block) computes kLanes elements per SIMD lane block but, per element, the
 // same sums in the same order as one element alone (no FMA: -ffp-contract=off), so the
 // model above, which allows any summation order, holds unchanged. Its loops over the lanes
 // carry `omp simd`: without it GCC 12 unrolled them into scalar code (measured: 2x slower

@@ -26,6 +26,7 @@
 #include <mutex>
 #include <vector>
 
+#include "analysis/native_lanes.hpp"
 #include "analysis/sparse_rows.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"
@@ -72,8 +73,8 @@ struct ProductScratch {
 
 class JacobianProduct {
  public:
-  /// Elements computed together, one per SIMD lane (8 doubles: one AVX-512 register).
-  static constexpr int kLanes = 8;
+  /// Elements computed together, one per SIMD lane (one vector register, native_lanes.hpp).
+  static constexpr int kLanes = kNativeLanes;
 
   /// @pre type a Lagrange line, triangle, quadrangle, tetrahedron, prism or hexahedron
   ///      (or pyramid, src/analysis/pyramid_space.cpp); basis = bezier_basis(type.family,

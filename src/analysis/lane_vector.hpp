@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <cstring>
 
+#include "analysis/native_lanes.hpp"
+
 namespace quadval {
 
 template <int W>
@@ -69,15 +71,21 @@ double fold_max(V v, double m) {
 // quadratic quadrangles: 3% slower with lanes from 8 values on).
 inline constexpr std::size_t kFoldLanesFrom = 32;
 
+// The folds below keep 8 running values (x_i in value i % 8), in registers of
+// kNativeLanes, and fold them in the order 0..7: the same bits on every target.
+inline constexpr int kFoldRegisters = 8 / kNativeLanes;
+
 /// The least of x_0..x_{n-1} as std::min folds them (+inf for n = 0), 8 lanes at a time.
 inline double least_value(const double* x, std::size_t n) {
   constexpr double kInf = __builtin_inf();
   double m = kInf;
   std::size_t i = 0;
   if (n >= kFoldLanesFrom) {
-    Lanes<8> m8 = broadcast_lanes<8>(kInf);
-    for (; i + 8 <= n; i += 8) m8 = vmin(m8, load_lanes<8>(x + i));
-    m = fold_min(m8, kInf);
+    Lanes<kNativeLanes> m8[kFoldRegisters];
+    for (auto& r : m8) r = broadcast_lanes<kNativeLanes>(kInf);
+    for (; i + 8 <= n; i += 8)
+      for (int r = 0; r < kFoldRegisters; ++r) m8[r] = vmin(m8[r], load_lanes<kNativeLanes>(x + i + r * kNativeLanes));
+    for (const auto& r : m8) m = fold_min(r, m);
   }
   for (; i < n; ++i) m = std::min(m, x[i]);
   return m;
@@ -87,9 +95,12 @@ inline double largest_magnitude(const double* x, std::size_t n) {
   double m = 0;
   std::size_t i = 0;
   if (n >= kFoldLanesFrom) {
-    Lanes<8> m8 = broadcast_lanes<8>(0);
-    for (; i + 8 <= n; i += 8) m8 = vmax(m8, vabs(load_lanes<8>(x + i)));
-    m = fold_max(m8, 0.0);
+    Lanes<kNativeLanes> m8[kFoldRegisters];
+    for (auto& r : m8) r = broadcast_lanes<kNativeLanes>(0);
+    for (; i + 8 <= n; i += 8)
+      for (int r = 0; r < kFoldRegisters; ++r)
+        m8[r] = vmax(m8[r], vabs(load_lanes<kNativeLanes>(x + i + r * kNativeLanes)));
+    for (const auto& r : m8) m = fold_max(r, m);
   }
   for (; i < n; ++i) m = std::max(m, std::abs(x[i]));
   return m;

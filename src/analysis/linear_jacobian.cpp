@@ -10,6 +10,7 @@
 #include <cstring>
 #include <limits>
 
+#include "analysis/native_lanes.hpp"
 #include "analysis/outward_rounding.hpp"
 
 namespace quadval {
@@ -22,7 +23,7 @@ constexpr double kMinNorm = 0x1p-200, kMaxNorm = 0x1p200;
 // The element arithmetic is written once over T: double (one element) or Lanes (kLanes
 // elements side by side, GCC vector extension: the same IEEE operations lane by lane, so
 // the results are bit-identical to the scalar ones; -ffp-contract=off applies to both).
-constexpr int kLanes = 8;
+constexpr int kLanes = kNativeLanes;
 using Lanes = double __attribute__((vector_size(kLanes * sizeof(double))));
 static_assert(kLinearChunk % kLanes == 0);
 

@@ -210,12 +210,13 @@ std::optional<QualityBounds> refined_hex_mu(std::span<const double> nodes, const
 
 void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
 
-unsigned straight_tet_mu_lanes(const ElementType& type, const Lanes<8>* edges, const Lanes<8>* margins, double tol,
-                               QualityBounds* out) {
+unsigned straight_tet_mu_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
+                               const Lanes<kNativeLanes>* margins, double tol, QualityBounds* out) {
   if (!mu_constant_path_enabled()) return 0;
-  const StraightTetRatio<8> r = straight_tet_ratio<8>(edges, margins, mu_space(type).ideal_inverse());
+  const StraightTetRatio<kNativeLanes> r =
+      straight_tet_ratio<kNativeLanes>(edges, margins, mu_space(type).ideal_inverse());
   unsigned done = 0;
-  for (int l = 0; l < 8; ++l)
+  for (int l = 0; l < kNativeLanes; ++l)
     if ((r.ok >> l) & 1u)
       if (const auto mu = mu_from_ratio(r.lower[l], r.upper[l], tol)) {
         out[l] = *mu;

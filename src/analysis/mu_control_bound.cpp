@@ -157,39 +157,40 @@ bool ratio_at_least3(const double* m, double err, double r) {
 
 namespace {
 
-using L8 = Lanes<8>;
+constexpr int kW = kNativeLanes;
+using LW = Lanes<kW>;
 using lanes3::down;
 using lanes3::up;
 
-// ratio_at_least3 on 8 matrices at once (lane l: entries m[i][l]), bit-identical decisions
+// ratio_at_least3 on kW matrices at once (lane l: entries m[i][l]), bit-identical decisions
 // (symmetric3_lanes.hpp); true lanes set in the returned mask.
-unsigned ratio_at_least3_lanes(const L8* m, double err, double r) {
-  return lanes3::mask_bits<8>(lanes3::ratio_at_least<8>(m, err, r));
+unsigned ratio_at_least3_lanes(const LW* m, double err, double r) {
+  return lanes3::mask_bits<kW>(lanes3::ratio_at_least<kW>(m, err, r));
 }
 
-// symmetric_eigen_enclosure<2>(m, err).ratio_lower() of 8 matrices at once (lane l:
+// symmetric_eigen_enclosure<2>(m, err).ratio_lower() of kW matrices at once (lane l:
 // entries m[i][l]), each lane with the scalar functions' operations in the same order
 // (bit-identical per matrix).
-L8 enclosure_ratio_lower2_lanes(const L8* m, double err) {
-  const L8 zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
-  const L8 rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
-  const L8 s_hi = up<8>(vabs(s) + rq), s_lo = vmax(zero, down<8>(vabs(s) - rq));
-  const L8 t_hi = up<8>(vabs(t) + err), t_lo = vmax(zero, down<8>(vabs(t) - err));
-  L8 d_hi = up<8>(up<8>(s_hi * s_hi) + up<8>(t_hi * t_hi));
-  L8 d_lo = vmax(zero, down<8>(down<8>(s_lo * s_lo) + down<8>(t_lo * t_lo)));
-  for (int l = 0; l < 8; ++l) {  // vsqrtpd: exact rounding, as std::sqrt
+LW enclosure_ratio_lower2_lanes(const LW* m, double err) {
+  const LW zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
+  const LW rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
+  const LW s_hi = up<kW>(vabs(s) + rq), s_lo = vmax(zero, down<kW>(vabs(s) - rq));
+  const LW t_hi = up<kW>(vabs(t) + err), t_lo = vmax(zero, down<kW>(vabs(t) - err));
+  LW d_hi = up<kW>(up<kW>(s_hi * s_hi) + up<kW>(t_hi * t_hi));
+  LW d_lo = vmax(zero, down<kW>(down<kW>(s_lo * s_lo) + down<kW>(t_lo * t_lo)));
+  for (int l = 0; l < kW; ++l) {  // vsqrtpd: exact rounding, as std::sqrt
     d_hi[l] = std::sqrt(d_hi[l]);
     d_lo[l] = std::sqrt(d_lo[l]);
   }
-  d_hi = up<8>(d_hi);
-  d_lo = vmax(zero, down<8>(d_lo));
-  const L8 q_lo = down<8>(q - rq), q_hi = up<8>(q + rq);
-  const L8 min_lo = down<8>(q_lo - d_hi), max_hi = up<8>(q_hi + d_hi);
+  d_hi = up<kW>(d_hi);
+  d_lo = vmax(zero, down<kW>(d_lo));
+  const LW q_lo = down<kW>(q - rq), q_hi = up<kW>(q + rq);
+  const LW min_lo = down<kW>(q_lo - d_hi), max_hi = up<kW>(q_hi + d_hi);
   constexpr double kMax = std::numeric_limits<double>::max();
   // An enclosure that is unknown (a non-finite step) or not positive: ratio 0.
   const auto known = (vabs(q_lo) <= kMax) & (vabs(q_hi) <= kMax) & (vabs(d_hi) <= kMax) & (min_lo > 0) & (max_hi < kInf);
-  const L8 ratio = down<8>(min_lo / max_hi);
-  return known ? vmin(vmax(ratio, zero), L8{} + 1) : zero;
+  const LW ratio = down<kW>(min_lo / max_hi);
+  return known ? vmin(vmax(ratio, zero), LW{} + 1) : zero;
 }
 
 // cos(acos(c) / 3) for c in [-1, 1], without trigonometric calls (acos and sincos were a
@@ -284,21 +285,21 @@ double ratio_estimate3(const double* m) {
 
 namespace {
 
-// 2D: every matrix's enclosure, 8 at a time, branch-free (the closed form is about as
+// 2D: every matrix's enclosure, kW at a time, branch-free (the closed form is about as
 // cheap as the test that would skip it; the last block repeats matrix 0 in its spare
 // lanes).
 double control_ratio_lower2(const double* const* entries, double e, int size) {
   double r = 1;
-  for (int k = 0; k < size; k += 8) {
-    L8 lanes[3];
+  for (int k = 0; k < size; k += kW) {
+    LW lanes[3];
     for (int i = 0; i < 3; ++i) {
-      if (size - k >= 8) {
-        lanes[i] = load_lanes<8>(entries[i] + k);
+      if (size - k >= kW) {
+        lanes[i] = load_lanes<kW>(entries[i] + k);
         continue;
       }
-      double tail[8];
-      for (int l = 0; l < 8; ++l) tail[l] = entries[i][k + l < size ? k + l : 0];
-      lanes[i] = load_lanes<8>(tail);
+      double tail[kW];
+      for (int l = 0; l < kW; ++l) tail[l] = entries[i][k + l < size ? k + l : 0];
+      lanes[i] = load_lanes<kW>(tail);
     }
     r = fold_min(enclosure_ratio_lower2_lanes(lanes, e), r);
   }
@@ -337,7 +338,7 @@ double control_ratio_lower3(const double* const* entries, double e, int size, do
       if (!(r < 1 && ratio_at_least3(m, e, r))) enclose(first);
     }
   }
-  // Once a ratio is certified, the cheap test runs on 8 control matrices at once with the
+  // Once a ratio is certified, the cheap test runs on kW control matrices at once with the
   // r of the block's start; a matrix it certifies is at least that r, so at least the
   // current one, and is skipped as the scalar test would skip it (the test is monotone in
   // r). Only the others go through the scalar test below, in order; a matrix the block
@@ -351,14 +352,14 @@ double control_ratio_lower3(const double* const* entries, double e, int size, do
     if (k == first) continue;
     if (r < 1 && k >= block_end && size - k >= 4) {
       block_start = k;
-      block_end = std::min(k + 8, size);
+      block_end = std::min(k + kW, size);
       block_r = r;
-      Lanes<8> lanes[6];
+      Lanes<kW> lanes[6];
       for (int i = 0; i < 6; ++i)
-        if (block_end - k == 8)
-          lanes[i] = load_lanes<8>(entries[i] + k);
+        if (block_end - k == kW)
+          lanes[i] = load_lanes<kW>(entries[i] + k);
         else
-          for (int l = 0; l < 8; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
+          for (int l = 0; l < kW; ++l) lanes[i][l] = k + l < block_end ? entries[i][k + l] : (i < 3 ? 1.0 : 0.0);
       certified = ratio_at_least3_lanes(lanes, e, r);
     }
     if (k < block_end && ((certified >> (k - block_start)) & 1u) != 0) continue;

@@ -20,7 +20,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kStraight = 1e-9;  // deviation / edge below which an element counts as straight
 constexpr double kUnderflow = 0x1p-1000;
 
-constexpr std::size_t kLanes = 8;  // elements side by side (lane_vector.hpp, also vabs and vmax)
+constexpr std::size_t kLanes = kNativeLanes;  // elements side by side (lane_vector.hpp, also vabs and vmax)
 // The first-order kind of a curved type's vertices (pyramids excluded: Bergot's
 // first-order map is not in the space of the higher orders' maps).
 LinearKind vertex_kind(const ElementType& type, bool planar) noexcept {

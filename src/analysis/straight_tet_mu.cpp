@@ -60,6 +60,8 @@ StraightTetRatio<W> straight_tet_ratio(const Lanes<W>* a, const Lanes<W>* beta, 
 }
 
 template StraightTetRatio<2> straight_tet_ratio<2>(const Lanes<2>*, const Lanes<2>*, const std::array<double, 9>&);
-template StraightTetRatio<8> straight_tet_ratio<8>(const Lanes<8>*, const Lanes<8>*, const std::array<double, 9>&);
+template StraightTetRatio<kNativeLanes> straight_tet_ratio<kNativeLanes>(const Lanes<kNativeLanes>*,
+                                                                         const Lanes<kNativeLanes>*,
+                                                                         const std::array<double, 9>&);
 
 }  // namespace quadval

@@ -33,17 +33,19 @@ template <int W>
 StraightTetRatio<W> straight_tet_ratio(const Lanes<W>* a, const Lanes<W>* beta, const std::array<double, 9>& jinv);
 
 extern template StraightTetRatio<2> straight_tet_ratio<2>(const Lanes<2>*, const Lanes<2>*, const std::array<double, 9>&);
-extern template StraightTetRatio<8> straight_tet_ratio<8>(const Lanes<8>*, const Lanes<8>*, const std::array<double, 9>&);
+extern template StraightTetRatio<kNativeLanes> straight_tet_ratio<kNativeLanes>(const Lanes<kNativeLanes>*,
+                                                                                const Lanes<kNativeLanes>*,
+                                                                                const std::array<double, 9>&);
 
 struct QualityBounds;
 struct ElementType;
 
-/// mu of 8 valid straight-sided tetrahedra of `type` (lanes; edges and margins as
+/// mu of kNativeLanes valid straight-sided tetrahedra of `type` (lanes; edges and margins as
 /// straight_tet_ratio's: the straight-sided margins mu_bounds_given gets, or 0 for first
 /// order), each as mu_bounds_given computes it (bit-identical): bit l of the result is set
 /// where out[l] holds lane l's bounds; the other lanes need mu_bounds_given (a failed step,
 /// or bounds wider than tol). Nothing while mu_use_constant_path(false).
-unsigned straight_tet_mu_lanes(const ElementType& type, const Lanes<8>* edges, const Lanes<8>* margins, double tol,
-                               QualityBounds* out);
+unsigned straight_tet_mu_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
+                               const Lanes<kNativeLanes>* margins, double tol, QualityBounds* out);
 
 }  // namespace quadval

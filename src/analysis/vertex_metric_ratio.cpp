@@ -41,7 +41,29 @@ CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*
 CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], int slots, int vertices,
                                     const double (*w)[8][3], double err, double delta, double enough) {
   using namespace lanes3;
-  using L8 = Lanes<8>;
+  // A block of 8 slots in kParts registers of kW lanes (lane_vector.hpp: wider vectors cost
+  // more than their parts); each slot's arithmetic, the decisions and the folds' order are
+  // those of one 8-lane block.
+  constexpr int kW = kNativeLanes, kParts = 8 / kW;
+  constexpr unsigned kAll = (1u << kW) - 1;
+  using LW = Lanes<kW>;
+  const auto load_block = [&](int block, LW (*mb)[6]) {
+    for (int p = 0; p < kParts; ++p)
+      for (int e = 0; e < 6; ++e) mb[p][e] = load_lanes<kW>(&m[e][8 * block + kW * p]);
+  };
+  // The enclosures of a block's matrices; false unless all are certified positive definite.
+  const auto enclose = [&](LW (*mb)[6], ExtremeEigen<kW>* eig) {
+    bool positive = true;
+    for (int p = 0; p < kParts; ++p) {
+      eig[p] = extreme_eigen<kW>(mb[p], broadcast_lanes<kW>(err));
+      positive = positive && mask_bits<kW>(eig[p].ok & (eig[p].lo > 0)) == kAll;
+    }
+    return positive;
+  };
+  const auto fold_ratios = [&](const ExtremeEigen<kW>* eig, double r) {
+    for (int p = 0; p < kParts; ++p) r = fold_min(down<kW>(eig[p].lo / eig[p].hi), r);
+    return r;
+  };
   CertifiedRatio out;
   // Lower: the least certified ratio of the control matrices (mu_control_bound.hpp), or 0
   // where one of them is not certified positive definite (control matrices of M need not
@@ -49,35 +71,42 @@ CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], i
   // block is enclosed first; a later block only where the cheaper test does not certify
   // all its lanes at least the least ratio so far (or `enough`, if less), which then is
   // the bound (a good element's later blocks mostly pass: hex_box_30 mu 30.3 -> 24.6 ms).
-  L8 vertex_m[6];
-  for (int e = 0; e < 6; ++e) vertex_m[e] = load_lanes<8>(m[e]);
-  const ExtremeEigen<8> vertex_eig = extreme_eigen<8>(vertex_m, broadcast_lanes<8>(err));
-  if (mask_bits<8>(vertex_eig.ok & (vertex_eig.lo > 0)) != 0xffu) return out;
-  double lower = fold_min(down<8>(vertex_eig.lo / vertex_eig.hi), 1.0);
+  LW vertex_m[kParts][6];
+  ExtremeEigen<kW> vertex_eig[kParts];
+  load_block(0, vertex_m);
+  if (!enclose(vertex_m, vertex_eig)) return out;
+  double lower = fold_ratios(vertex_eig, 1.0);
   for (int block = 1; block < slots / 8; ++block) {
-    L8 mb[6];
-    for (int e = 0; e < 6; ++e) mb[e] = load_lanes<8>(&m[e][8 * block]);
+    LW mb[kParts][6];
+    load_block(block, mb);
     const double floor = std::min(lower, enough);
-    if (floor > 0 && floor < 1 && mask_bits<8>(ratio_at_least<8>(mb, err, floor)) == 0xffu) {
-      lower = floor;
-      continue;
+    if (floor > 0 && floor < 1) {
+      bool all = true;
+      for (int p = 0; p < kParts && all; ++p) all = mask_bits<kW>(ratio_at_least<kW>(mb[p], err, floor)) == kAll;
+      if (all) {
+        lower = floor;
+        continue;
+      }
     }
-    const ExtremeEigen<8> eig = extreme_eigen<8>(mb, broadcast_lanes<8>(err));
-    if (mask_bits<8>(eig.ok & (eig.lo > 0)) != 0xffu) {
+    ExtremeEigen<kW> eig[kParts];
+    if (!enclose(mb, eig)) {
       lower = 0;  // R >= 0 is all that is known
       break;
     }
-    lower = fold_min(down<8>(eig.lo / eig.hi), lower);
+    lower = fold_ratios(eig, lower);
   }
-  // Upper: Rayleigh quotients of W at the vertices (lanes 0 to vertices - 1 of block 0).
-  L8 wv[3][3];
-  for (int j = 0; j < 3; ++j)
-    for (int c = 0; c < 3; ++c)
-      for (int l = 0; l < 8; ++l) wv[j][c][l] = w[j][l < vertices ? l : 0][c];
-  Mask<8> vectors_ok;
-  const L8 upper = ratio_upper<8>(wv, vertex_m, vertex_eig.lo, vertex_eig.hi, broadcast_lanes<8>(delta), vectors_ok);
+  // Upper: Rayleigh quotients of W at the vertices (slots 0 to vertices - 1 of block 0).
   double best = 1;
-  for (int l = 0; l < vertices; ++l) best = std::min(best, upper[l]);
+  for (int p = 0; p < kParts && kW * p < vertices; ++p) {
+    LW wv[3][3];
+    for (int j = 0; j < 3; ++j)
+      for (int c = 0; c < 3; ++c)
+        for (int l = 0; l < kW; ++l) wv[j][c][l] = w[j][kW * p + l < vertices ? kW * p + l : 0][c];
+    Mask<kW> vectors_ok;
+    const LW upper = ratio_upper<kW>(wv, vertex_m[p], vertex_eig[p].lo, vertex_eig[p].hi,
+                                     broadcast_lanes<kW>(delta), vectors_ok);
+    for (int l = 0; l < kW && kW * p + l < vertices; ++l) best = std::min(best, upper[l]);
+  }
   out.lower = std::clamp(lower, 0.0, 1.0);
   out.upper = std::clamp(best, 0.0, 1.0);
   out.ok = out.lower <= out.upper;

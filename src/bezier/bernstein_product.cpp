@@ -486,19 +486,28 @@ void BernsteinProduct::fused_entries(std::span<const Term> terms, const std::vec
   }
 }
 
+// A GCC vector of N doubles (a typedef with a dependent vector_size is not one).
+namespace {
+template <int N>
+struct DoubleVector {
+  typedef double Type __attribute__((vector_size(8 * N)));
+};
+}  // namespace
+
 template <int Columns, int Coordinates>
 void BernsteinProduct::gram_entries(const double* const* w, double* const* h) const {
   // Lane e of a pair's sum is entry e's sum_x w[3 a_e + x](i) w[3 b_e + x](j): per
   // coefficient, its values laid out once as the vectors (x < Coordinates) of the a_e side
   // and those of the b_e side, so that a pair costs a vector product and a sum per x.
-  typedef double V8 __attribute__((vector_size(64)));
+  // 4 lanes hold 2 columns' 3 entries: with AVX2 only, 8 would cost two registers' work.
+  using V = typename DoubleVector<Columns == 2 ? 4 : 8>::Type;
   constexpr std::size_t kEntries = Columns * (Columns + 1) / 2;
   constexpr std::size_t kX = Coordinates;
   const auto entry = [](std::size_t e) { return Columns == 3 ? kGramEntries3[e] : kGramEntries2[e % 3]; };
-  thread_local std::vector<V8> side_a, side_b;
+  thread_local std::vector<V> side_a, side_b;
   const auto n = static_cast<std::size_t>(f_size_);
-  side_a.assign(kX * n, V8{});
-  side_b.assign(kX * n, V8{});
+  side_a.assign(kX * n, V{});
+  side_b.assign(kX * n, V{});
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t x = 0; x < kX; ++x)
       for (std::size_t e = 0; e < kEntries; ++e) {
@@ -507,12 +516,12 @@ void BernsteinProduct::gram_entries(const double* const* w, double* const* h) co
       }
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
-    V8 acc{};
+    V acc{};
     for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
-      const V8* x = side_a.data() + kX * static_cast<std::size_t>(pairs[p].i);
-      const V8* y = side_b.data() + kX * static_cast<std::size_t>(pairs[p].j);
+      const V* x = side_a.data() + kX * static_cast<std::size_t>(pairs[p].i);
+      const V* y = side_b.data() + kX * static_cast<std::size_t>(pairs[p].j);
       // As fused_entries<3> with scales 1 (exact): the same roundings in the same order.
-      V8 sum = x[0] * y[0] + x[1] * y[1];
+      V sum = x[0] * y[0] + x[1] * y[1];
       if constexpr (kX == 3) sum = sum + x[2] * y[2];
       acc += pairs[p].w * sum;
     }

@@ -55,20 +55,21 @@ std::array<double, 9> random_edges(int e, std::mt19937& rng) {
 TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
   std::mt19937 rng(5150);
   const std::array<double, 9>& jinv = mu_space(*find_element_type(4)).ideal_inverse();
+  constexpr int kW = kNativeLanes;  // the width the checks run at
   int ok = 0, total = 0;
   for (int block = 0; block < 400; ++block) {
-    std::array<std::array<double, 9>, 8> edges;
-    std::array<double, 8> margin{};
-    Lanes<8> a[9], beta[3];
-    for (int l = 0; l < 8; ++l) {
-      edges[static_cast<std::size_t>(l)] = random_edges(block * 8 + l, rng);
+    std::array<std::array<double, 9>, kW> edges;
+    std::array<double, kW> margin{};
+    Lanes<kW> a[9], beta[3];
+    for (int l = 0; l < kW; ++l) {
+      edges[static_cast<std::size_t>(l)] = random_edges(block * kW + l, rng);
       // Half the blocks with a straight-sided margin on the columns (higher-order nodes).
       margin[static_cast<std::size_t>(l)] = block % 2 == 0 ? 0.0 : 1e-9 * std::abs(edges[static_cast<std::size_t>(l)][0]);
       for (int v = 0; v < 9; ++v) a[v][l] = edges[static_cast<std::size_t>(l)][static_cast<std::size_t>(v)];
       for (int c = 0; c < 3; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
     }
-    const StraightTetRatio<8> r = straight_tet_ratio<8>(a, beta, jinv);
-    for (int l = 0; l < 8; ++l) {
+    const StraightTetRatio<kW> r = straight_tet_ratio<kW>(a, beta, jinv);
+    for (int l = 0; l < kW; ++l) {
       ++total;
       const auto& x = edges[static_cast<std::size_t>(l)];
       // The same element alone, in both lanes of two: the same bits.
@@ -76,19 +77,19 @@ TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
       for (int v = 0; v < 9; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
       for (int c = 0; c < 3; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
       const StraightTetRatio<2> alone = straight_tet_ratio<2>(a2, b2, jinv);
-      ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * 8 + l;
+      ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * kW + l;
       if (((r.ok >> l) & 1u) == 0) continue;
       ++ok;
       EXPECT_EQ(r.lower[l], alone.lower[0]);
       EXPECT_EQ(r.upper[l], alone.upper[0]);
       const long double exact = exact_ratio(x.data(), jinv);
-      EXPECT_LE(r.lower[l], exact * (1 + 1e-15L)) << "element " << block * 8 + l;
-      EXPECT_GE(r.upper[l], exact * (1 - 1e-15L)) << "element " << block * 8 + l;
+      EXPECT_LE(r.lower[l], exact * (1 + 1e-15L)) << "element " << block * kW + l;
+      EXPECT_GE(r.upper[l], exact * (1 - 1e-15L)) << "element " << block * kW + l;
       EXPECT_LE(r.lower[l], r.upper[l]);
       // Tight: to rounding without a margin, within a few margins (relative 1e-9) with one.
       const double gap = margin[static_cast<std::size_t>(l)] == 0 ? 1e-7 : 1e-4;
       if (exact > 1e-3L) {
-        EXPECT_LE(r.upper[l] - r.lower[l], gap * static_cast<double>(exact)) << "element " << block * 8 + l;
+        EXPECT_LE(r.upper[l] - r.lower[l], gap * static_cast<double>(exact)) << "element " << block * kW + l;
       }
     }
   }
