@@ -26,7 +26,7 @@
 #include <mutex>
 #include <vector>
 
-#include "analysis/native_lanes.hpp"
+#include "bezier/native_lanes.hpp"
 #include "analysis/sparse_rows.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/element_type.hpp"

@@ -11,7 +11,7 @@
 #include <cstddef>
 #include <cstring>
 
-#include "analysis/native_lanes.hpp"
+#include "bezier/native_lanes.hpp"
 
 namespace quadval {
 

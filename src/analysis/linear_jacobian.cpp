@@ -10,7 +10,7 @@
 #include <cstring>
 #include <limits>
 
-#include "analysis/native_lanes.hpp"
+#include "bezier/native_lanes.hpp"
 #include "analysis/outward_rounding.hpp"
 
 namespace quadval {

@@ -30,6 +30,7 @@
 #include <tuple>
 
 #include "bezier/multi_index_table.hpp"
+#include "bezier/native_lanes.hpp"
 #include "bezier/rational_rounding.hpp"
 #include "quadval/error.hpp"
 
@@ -498,34 +499,45 @@ template <int Columns, int Coordinates>
 void BernsteinProduct::gram_entries(const double* const* w, double* const* h) const {
   // Lane e of a pair's sum is entry e's sum_x w[3 a_e + x](i) w[3 b_e + x](j): per
   // coefficient, its values laid out once as the vectors (x < Coordinates) of the a_e side
-  // and those of the b_e side, so that a pair costs a vector product and a sum per x.
-  // 4 lanes hold 2 columns' 3 entries: with AVX2 only, 8 would cost two registers' work.
-  using V = typename DoubleVector<Columns == 2 ? 4 : 8>::Type;
+  // and those of the b_e side, so that a pair costs a vector product and a sum per x. The
+  // entries fill vectors of at most the native width (native_lanes.hpp): 2 columns' 3
+  // entries one vector of 4; 3 columns' 6 one of 8 with AVX-512, else two of 4 (a vector of
+  // 8 there was kept in memory and moved through integer registers: mu of warped_prism_o2,
+  // AVX2, one thread, BM_CheckSharedQuality: see the commit).
   constexpr std::size_t kEntries = Columns * (Columns + 1) / 2;
+  constexpr int kWidth = Columns == 2 ? 4 : kNativeLanes;
+  constexpr std::size_t kParts = (kEntries + kWidth - 1) / kWidth;  // vectors per side and x
+  static_assert(kParts <= 2);
+  using V = typename DoubleVector<kWidth>::Type;
   constexpr std::size_t kX = Coordinates;
   const auto entry = [](std::size_t e) { return Columns == 3 ? kGramEntries3[e] : kGramEntries2[e % 3]; };
-  thread_local std::vector<V> side_a, side_b;
+  thread_local std::vector<V> side_a, side_b;  // (coefficient i, part, x) at (i kParts + part) kX + x
   const auto n = static_cast<std::size_t>(f_size_);
-  side_a.assign(kX * n, V{});
-  side_b.assign(kX * n, V{});
+  side_a.assign(kParts * kX * n, V{});
+  side_b.assign(kParts * kX * n, V{});
   for (std::size_t i = 0; i < n; ++i)
     for (std::size_t x = 0; x < kX; ++x)
       for (std::size_t e = 0; e < kEntries; ++e) {
-        side_a[kX * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[0]) + x][i];
-        side_b[kX * i + x][e] = w[3 * static_cast<std::size_t>(entry(e)[1]) + x][i];
+        const std::size_t at = (i * kParts + e / kWidth) * kX + x;
+        side_a[at][e % kWidth] = w[3 * static_cast<std::size_t>(entry(e)[0]) + x][i];
+        side_b[at][e % kWidth] = w[3 * static_cast<std::size_t>(entry(e)[1]) + x][i];
       }
+  // As fused_entries<3> with scales 1 (exact): the same roundings in the same order.
+  const auto dot = [](const V* a, const V* b) {
+    V sum = a[0] * b[0] + a[1] * b[1];
+    if constexpr (kX == 3) sum = sum + a[2] * b[2];
+    return sum;
+  };
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
-    V acc{};
+    V acc0{}, acc1{};  // parts 0 and 1 (named: an array of vectors was kept in memory)
     for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
-      const V* x = side_a.data() + kX * static_cast<std::size_t>(pairs[p].i);
-      const V* y = side_b.data() + kX * static_cast<std::size_t>(pairs[p].j);
-      // As fused_entries<3> with scales 1 (exact): the same roundings in the same order.
-      V sum = x[0] * y[0] + x[1] * y[1];
-      if constexpr (kX == 3) sum = sum + x[2] * y[2];
-      acc += pairs[p].w * sum;
+      const V* x = side_a.data() + kParts * kX * static_cast<std::size_t>(pairs[p].i);
+      const V* y = side_b.data() + kParts * kX * static_cast<std::size_t>(pairs[p].j);
+      acc0 += pairs[p].w * dot(x, y);
+      if constexpr (kParts == 2) acc1 += pairs[p].w * dot(x + kX, y + kX);
     }
-    for (std::size_t e = 0; e < kEntries; ++e) h[e][k] += acc[e];
+    for (std::size_t e = 0; e < kEntries; ++e) h[e][k] += e < kWidth ? acc0[e % kWidth] : acc1[e % kWidth];
   }
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The lane width of the vectorised element arithmetic. Internal to src/analysis.
+// The lane width of the vectorised arithmetic (src/bezier, src/analysis).
 
 namespace quadval {
 
