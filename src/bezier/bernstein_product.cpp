@@ -502,8 +502,8 @@ void BernsteinProduct::gram_entries(const double* const* w, double* const* h) co
   // and those of the b_e side, so that a pair costs a vector product and a sum per x. The
   // entries fill vectors of at most the native width (native_lanes.hpp): 2 columns' 3
   // entries one vector of 4; 3 columns' 6 one of 8 with AVX-512, else two of 4 (a vector of
-  // 8 there was kept in memory and moved through integer registers: mu of warped_prism_o2,
-  // AVX2, one thread, BM_CheckSharedQuality: see the commit).
+  // 8 there was kept in memory and moved through integer registers; mu on AVX2, one thread:
+  // warped_hexahedron_o2 1.84 -> 1.33 ms, warped_prism_o2 4.0 -> 3.46 ms).
   constexpr std::size_t kEntries = Columns * (Columns + 1) / 2;
   constexpr int kWidth = Columns == 2 ? 4 : kNativeLanes;
   constexpr std::size_t kParts = (kEntries + kWidth - 1) / kWidth;  // vectors per side and x
