@@ -50,7 +50,12 @@ void expect_both(const std::vector<double>& num, double a, const std::vector<dou
 TEST(RatioScan, EqualsThePlainLoopBitForBit) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
-  for (std::size_t size = 1; size <= 40; ++size) {
+  // Every length to 40, then lengths around the blocks of 64 that the path without
+  // AVX-512 divides at a time.
+  std::vector<std::size_t> sizes;
+  for (std::size_t size = 1; size <= 40; ++size) sizes.push_back(size);
+  for (std::size_t size : {63, 64, 65, 100, 127, 128, 129, 200}) sizes.push_back(size);
+  for (std::size_t size : sizes) {
     for (int trial = 0; trial < 200; ++trial) {
       std::vector<double> num(size), den(size);
       const int scale = static_cast<int>(40 * u(rng));
