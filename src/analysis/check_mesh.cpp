@@ -459,8 +459,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             };
             // mu of a chunk's valid straight-sided tetrahedra (decided by linear_validity_chunk,
             // vertices in `soa` by vertex and axis, rows of `row`; betas: the straight-sided
-            // margins of the columns, 3 per element, or none for first-order ones), kNativeLanes
-            // at a time (straight_tet_mu.hpp): bit i % W of lane_mu_done[i / W] set where
+            // margins of the columns, 3 per element, or none for first-order ones), W =
+            // kNativeLanes at a time (straight_tet_mu.hpp): bit i % W of lane_mu_done[i / W] set where
             // lane_mu[i] holds element i's, as mu_bounds_given would compute it.
             const auto tet_mu_lanes = [&](const ElementType& t, std::size_t row, const double* betas, std::size_t count) {
               lane_mu.resize(kLinearChunk);
