@@ -16,10 +16,6 @@
 namespace quadval {
 
 template <int W>
-struct LaneVector {
-  typedef double Type __attribute__((vector_size(8 * W)));
-};
-template <int W>
 using Lanes = typename LaneVector<W>::Type;
 
 template <int W>

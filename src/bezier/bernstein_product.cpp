@@ -487,14 +487,6 @@ void BernsteinProduct::fused_entries(std::span<const Term> terms, const std::vec
   }
 }
 
-// A GCC vector of N doubles (a typedef with a dependent vector_size is not one).
-namespace {
-template <int N>
-struct DoubleVector {
-  typedef double Type __attribute__((vector_size(8 * N)));
-};
-}  // namespace
-
 template <int Columns, int Coordinates>
 void BernsteinProduct::gram_entries(const double* const* w, double* const* h) const {
   // Lane e of a pair's sum is entry e's sum_x w[3 a_e + x](i) w[3 b_e + x](j): per
@@ -508,7 +500,7 @@ void BernsteinProduct::gram_entries(const double* const* w, double* const* h) co
   constexpr int kWidth = Columns == 2 ? 4 : kNativeLanes;
   constexpr std::size_t kParts = (kEntries + kWidth - 1) / kWidth;  // vectors per side and x
   static_assert(kParts <= 2);
-  using V = typename DoubleVector<kWidth>::Type;
+  using V = typename LaneVector<kWidth>::Type;
   constexpr std::size_t kX = Coordinates;
   const auto entry = [](std::size_t e) { return Columns == 3 ? kGramEntries3[e] : kGramEntries2[e % 3]; };
   thread_local std::vector<V> side_a, side_b;  // (coefficient i, part, x) at (i kParts + part) kX + x

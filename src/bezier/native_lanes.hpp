@@ -17,4 +17,10 @@ inline constexpr int kNativeLanes =
     4;
 #endif
 
+/// A GCC vector of W doubles (LaneVector<W>::Type; src/analysis names it Lanes<W>).
+template <int W>
+struct LaneVector {
+  typedef double Type __attribute__((vector_size(8 * W)));
+};
+
 }  // namespace quadval
