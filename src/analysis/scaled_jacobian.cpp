@@ -403,6 +403,9 @@ QuotientInput quotient_input(const Polys& polys, std::size_t dim) {
       in.col_magnitude[c] = std::max(in.col_magnitude[c], polys.col[c][x].b.m);
     }
   }
+  bool flat = true;
+  for (std::size_t c = 0; c < dim; ++c) flat = flat && polys.col[c][2].b.m == 0;
+  if (flat) in.coordinates = 2;
   return in;
 }
 

@@ -436,6 +436,62 @@ class Quotient {
     return lower;
   }
 
+  // Frame column f's first nx coordinates (the others are zero) at the leaf's n control
+  // points, into part[x * n + i]; their sums per coordinate into mean, and mag raised to
+  // their largest magnitude. The same operations as frame_coordinate, a coordinate at a
+  // time, so that the compiler vectorises the sums of columns.
+  void frame_column(const double* leaf, const FrameColumn& f, std::size_t n, std::size_t nx, double* part,
+                    std::array<double, 3>& mean, double& mag) const {
+    const auto source = [&](int t, std::size_t x) {
+      return leaf + layout_.offset[static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]) + 1] + x * n;
+    };
+    const double w0 = f.weight[0], w1 = f.weight[1], w2 = f.weight[2];
+    for (std::size_t x = 0; x < nx; ++x) {
+      double* out = part + x * n;
+      const double* s0 = source(0, x);
+      if (f.terms == 1) {
+        for (std::size_t i = 0; i < n; ++i) out[i] = 0.0 + w0 * s0[i];
+      } else if (f.terms == 2) {
+        const double* s1 = source(1, x);
+        for (std::size_t i = 0; i < n; ++i) out[i] = (0.0 + w0 * s0[i]) + w1 * s1[i];
+      } else {
+        const double *s1 = source(1, x), *s2 = source(2, x);
+        for (std::size_t i = 0; i < n; ++i) out[i] = ((0.0 + w0 * s0[i]) + w1 * s1[i]) + w2 * s2[i];
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        mean[x] += out[i];
+        mag = std::max(mag, std::abs(out[i]));
+      }
+    }
+  }
+  // directional_columns' pass over ws_.part (NX coordinates) with the unit vector d: the
+  // dot products a_i into along, their largest magnitude, the largest |V_i|^2 and, when
+  // shifted, the least a_i and the largest squared distance of V_i from the line along d.
+  template <std::size_t NX>
+  void along_mean(std::size_t n, const std::array<double, 3>& d, bool shifted, double* along, double& big,
+                  double& big_square, double& perp_square, double& a_min) const {
+    const double* v = ws_.part.data();
+    for (std::size_t i = 0; i < n; ++i) {
+      double a = v[i] * d[0];
+      double v2 = v[i] * v[i];
+      for (std::size_t x = 1; x < NX; ++x) {
+        a += v[x * n + i] * d[x];
+        v2 += v[x * n + i] * v[x * n + i];
+      }
+      along[i] = a;
+      big = std::max(big, std::abs(a));
+      big_square = std::max(big_square, v2);
+      if (!shifted) continue;
+      a_min = std::min(a_min, a);
+      double p2 = 0;
+      for (std::size_t x = 0; x < NX; ++x) {
+        const double p = v[x * n + i] - a * d[x];
+        p2 = x == 0 ? p * p : p2 + p * p;
+      }
+      perp_square = std::max(perp_square, p2);
+    }
+  }
+
   // Per distinct frame column dc of the leaf: ws_.along_of[dc] = its control points' dot
   // products with the unit vector d along their mean, ws_.big[dc] >= their magnitudes,
   // ws_.along_err[dc] >= their errors, and bounds of |v| at the leaf's corners (above:
@@ -461,6 +517,7 @@ class Quotient {
     ws_.corner_norm_lo.resize(nd * corners);
     if (ws_.along_of.size() < nd) ws_.along_of.resize(nd);
     std::uint32_t unusable = 0;
+    const std::size_t nx = in_.coordinates;
     for (std::size_t dc = 0; dc < nd; ++dc) {
       const FrameColumn& f = layout_.distinct[dc];
       const auto c0 = static_cast<std::size_t>(f.column[0]);
@@ -469,20 +526,14 @@ class Quotient {
       double mag = 0;
       ws_.part.resize(3 * n);
       std::array<double, 3> mean{0, 0, 0};
-      for (std::size_t x = 0; x < 3; ++x)
-        for (std::size_t i = 0; i < n; ++i) {
-          const double v = frame_coordinate(leaf, f, n, x, i);
-          ws_.part[x * n + i] = v;
-          mean[x] += v;
-          mag = std::max(mag, std::abs(v));
-        }
+      frame_column(leaf, f, n, nx, ws_.part.data(), mean, mag);
       const double spread = norm_spread(ev);
       // Corner norms: from above for the signed bound's corners (J < 0 there), from below
       // for the paired bound's (J > 0).
       for (std::size_t mi = 0; mi < corners; ++mi) {
         const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
         double sum = 0;
-        for (std::size_t x = 0; x < 3; ++x) sum += ws_.part[x * n + at] * ws_.part[x * n + at];
+        for (std::size_t x = 0; x < nx; ++x) sum += ws_.part[x * n + at] * ws_.part[x * n + at];
         const double norm = sqrt_rn(sum);
         if (shifted)
           ws_.corner_norm_lo[dc * corners + mi] = std::max(0.0, down(down(norm * (1 - 1e-12)) - spread));
@@ -500,17 +551,10 @@ class Quotient {
       std::vector<double>& along = ws_.along_of[dc];
       along.resize(n);
       double big = 0, big_square = 0, perp_square = 0, a_min = kInf;
-      for (std::size_t i = 0; i < n; ++i) {
-        const double v0 = ws_.part[i], v1 = ws_.part[n + i], v2 = ws_.part[2 * n + i];
-        const double a = v0 * d[0] + v1 * d[1] + v2 * d[2];
-        along[i] = a;
-        big = std::max(big, std::abs(a));
-        big_square = std::max(big_square, v0 * v0 + v1 * v1 + v2 * v2);
-        if (!shifted) continue;
-        a_min = std::min(a_min, a);
-        const double p0 = v0 - a * d[0], p1 = v1 - a * d[1], p2 = v2 - a * d[2];
-        perp_square = std::max(perp_square, p0 * p0 + p1 * p1 + p2 * p2);
-      }
+      if (nx == 2)
+        along_mean<2>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
+      else
+        along_mean<3>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
       const double vn = up(sqrt_rn(big_square) * (1 + 1e-12));  // >= every computed |V_i|
       ws_.big[dc] = big;
       ws_.norm_big[dc] = up(vn + spread);

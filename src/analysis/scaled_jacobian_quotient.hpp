@@ -60,6 +60,9 @@ struct QuotientInput {
   std::array<const std::vector<FactorDegree>*, 3> col_degrees{};
   std::array<double, 3> col_error{0, 0, 0};  ///< per column, every coordinate
   std::array<double, 3> col_magnitude{0, 0, 0};  ///< >= |every computed coefficient|
+  /// Coordinates that can be nonzero: 2 where every column's z coefficients are zero (an
+  /// element in a plane z = const), else 3.
+  std::size_t coordinates = 3;
 };
 
 /// Certified bounds of sj(E) on an element where J > 0 is proven, refined best-first until
