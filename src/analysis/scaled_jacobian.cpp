@@ -422,12 +422,15 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
   //    definition); error (4u entries + u differences + gamma_N sums) * row sum * R,
   //    counted as 6u + gamma_N.
   double range = 0;
+  bool flat_z = true;  // an element in a plane z = const: every column's z coefficients +0
   values.resize(nn * 3);
-  for (std::size_t i = 0; i < nn; ++i)
+  for (std::size_t i = 0; i < nn; ++i) {
     for (std::size_t j = 0; j < 3; ++j) {
       values[i * 3 + j] = nodes[3 * i + j] - nodes[j];
       range = std::max(range, std::abs(values[i * 3 + j]));
     }
+    flat_z = flat_z && values[i * 3 + 2] == 0;
+  }
   auto& col = polys.col;
   for (std::size_t c = 0; c < udim; ++c) {
     const SparseRows& m = space.column_nonzeros(static_cast<int>(c));
@@ -441,7 +444,10 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
     }
     for (std::size_t r = 0; r < rows; ++r) {
       double sum[3];
-      m.row_times_points(r, values.data(), sum);
+      if (flat_z)
+        m.row_times_flat_points(r, values.data(), sum);
+      else
+        m.row_times_points(r, values.data(), sum);
       for (std::size_t j = 0; j < 3; ++j) col[c][j].c[r] = sum[j];
     }
     for (std::size_t j = 0; j < 3; ++j) refresh_magnitude(col[c][j]);
