@@ -68,7 +68,11 @@ constexpr int kPairedSplits = 8;
 // 21.0, 18.4 ms (all 280 by 8; best of 7: 17.8 -> 11.5 ms at 8); hex_box's 295 within
 // noise. Tetrahedra (four frames per leaf) gained once its ratios were scanned without a
 // division each (ratio_scan.hpp): warped_tetrahedron_o3's 660, best of 5, three runs
-// each, 94-96 -> 82-87 ms.
+// each, 94-96 -> 82-87 ms. Re-measured on an AVX2 machine (whole mesh, each element best of
+// 3) with 0, 2, 4, 6, 8, 12, 16 splits: warped_tetrahedron_o3 124, 107, 92, 92, 89-91, 95,
+// 96 ms; warped_prism_o2 26, 17, 11.4 ms, then 8.9 ms from 6 on. The 128 (of 672) inverted
+// tetrahedra that 8 splits leave unsettled take 57-74 of those ms (17-22 in this stage):
+// more splits settle some of them, at more than the full path costs them.
 constexpr int kSignedSplits = 8;
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
