@@ -74,9 +74,9 @@
 //   solver: 0.07 s) and 3.8-5 s on uniform-100k: 10-28 bids per vertex per phase, and at
 //   each phase start about 90% of the assignment breaks the new epsilon. Re-tried plainly
 //   (forward auction, alpha = 10, every person unassigned at each phase start, global
-//   price updates every n or n/5 bids): 15 phases, 20-40 bids per vertex per phase, 8-15 s
-//   on uniform-100k; LEMON's CostScaling on the same cover (the extra edges at their cost
-//   1000) had not finished after 10 min.
+//   price updates every n or n/5 bids): 15 phases, 20-35 bids per vertex per phase (7
+//   with updates every n/5 bids, 542 updates), 8-15 s on uniform-100k; LEMON's CostScaling
+//   on the same cover (the extra edges at their cost 1000) had not finished after 10 min.
 // - Exact solves over cost scales (the costs' top bits first, 4 or 8 more bits per level,
 //   each level started from the last one's duals in cut form, scaled up, plus its matching):
 //   every level still left 600-1,000 free vertices and took 0.3-1 s; 3.5-6 s in all.
