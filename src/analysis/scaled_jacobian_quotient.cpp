@@ -468,7 +468,7 @@ class Quotient {
   // dot products a_i into along, their largest magnitude, the largest |V_i|^2 and, when
   // shifted, the least a_i and the largest squared distance of V_i from the line along d.
   template <std::size_t NX>
-  void along_mean(std::size_t n, const std::array<double, 3>& d, bool shifted, double* along, double& big,
+  void project_along(std::size_t n, const std::array<double, 3>& d, bool shifted, double* along, double& big,
                   double& big_square, double& perp_square, double& a_min) const {
     const double* v = ws_.part.data();
     for (std::size_t i = 0; i < n; ++i) {
@@ -552,9 +552,9 @@ class Quotient {
       along.resize(n);
       double big = 0, big_square = 0, perp_square = 0, a_min = kInf;
       if (nx == 2)
-        along_mean<2>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
+        project_along<2>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
       else
-        along_mean<3>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
+        project_along<3>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
       const double vn = up(sqrt_rn(big_square) * (1 + 1e-12));  // >= every computed |V_i|
       ws_.big[dc] = big;
       ws_.norm_big[dc] = up(vn + spread);
