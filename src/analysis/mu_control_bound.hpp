@@ -16,6 +16,17 @@
 // certificate of mu_metric.hpp does, at the cost of one small eigenvalue enclosure per
 // control matrix.
 //
+// Tried and dropped: Jensen kept as a polynomial, G(x) = sum_k B_k(x) c_k with certified
+// c_k <= g_r(M_k) at r = the settling target (r_target), proven G >= 0 by bisecting the
+// scalar G alone (up to 8 or 16 bisections) instead of W and M. On a grid G >= 0 held for
+// 64% of hex_box_N20's positive-definite roots the control bound leaves open, but once
+// certified (every c_k enclosed, G's sub-box vertices checked) it settled only 34% of all
+// the roots it was tried on (55% failed at a sub-box vertex where G < 0: the Jensen gap
+// itself, which no bisection of G removes), and 18-29% of the curved 3D roots (warped
+// tetrahedra and prisms). Cost beyond savings everywhere (per-element harness, best of 3):
+// hex_box 28-32 -> 37.5 ms, warped_prism_o2 3.9 -> 4.6 ms, warped_tetrahedron_o3 9.3 ->
+// 11.3 ms (root only), twice that when tried on every subdomain.
+//
 // Eigenvalue enclosures of one symmetric matrix known within an entrywise error e:
 //   2 x 2: lambda = q +- sqrt(s^2 + t^2) in interval arithmetic (Paper V §4);
 //   3 x 3: V = approximate eigenvectors (Eigen), B = V^T M V enclosed entrywise; the
