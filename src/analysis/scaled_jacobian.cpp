@@ -446,13 +446,26 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
       p.c.resize(rows);
       p.b.e = e;
     }
-    for (std::size_t r = 0; r < rows; ++r) {
-      double sum[3];
-      if (flat_z)
-        m.row_times_flat_points(r, values.data(), sum);
-      else
-        m.row_times_points(r, values.data(), sum);
-      for (std::size_t j = 0; j < 3; ++j) col[c][j].c[r] = sum[j];
+    if (range < kInf) {
+      // Four rows at a time (SparseRows::four_rows_times_points, the same bits).
+      for (std::size_t r0 = 0; r0 < rows; r0 += 4) {
+        Lanes<4> sum[3] = {};
+        if (flat_z)
+          m.four_rows_times_points<2>(r0 / 4, values.data(), sum);
+        else
+          m.four_rows_times_points<3>(r0 / 4, values.data(), sum);
+        for (std::size_t j = 0; j < 3; ++j)
+          for (std::size_t l = 0; l < 4 && r0 + l < rows; ++l) col[c][j].c[r0 + l] = sum[j][l];
+      }
+    } else {
+      for (std::size_t r = 0; r < rows; ++r) {
+        double sum[3];
+        if (flat_z)
+          m.row_times_flat_points(r, values.data(), sum);
+        else
+          m.row_times_points(r, values.data(), sum);
+        for (std::size_t j = 0; j < 3; ++j) col[c][j].c[r] = sum[j];
+      }
     }
     for (std::size_t j = 0; j < 3; ++j) refresh_magnitude(col[c][j]);
   }
