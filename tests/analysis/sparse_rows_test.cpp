@@ -1,5 +1,5 @@
 // SparseRows (sparse_rows.hpp) against the dense map it was built from: the same sums bit
-// for bit, on the node maps of real element types and on random maps with zeros and
+// for bit (one row at a time, and four rows in lanes), on the node maps of real element types and on random maps with zeros and
 // signed zeros.
 #include <gtest/gtest.h>
 
@@ -53,6 +53,20 @@ void check_map(const std::vector<double>& map, std::size_t rows, std::size_t n, 
         sparse.row_times_flat_points(r, d.data(), got);
         for (int a = 0; a < 3; ++a) expect_same_bits(got[a], want[a], "row_times_flat_points");
       }
+      // Four rows at once, lane r % 4 of block r / 4 (the z sum skipped where flat, +0).
+      Lanes<4> lanes[3] = {};
+      if (flat)
+        sparse.four_rows_times_points<2>(r / 4, d.data(), lanes);
+      else
+        sparse.four_rows_times_points<3>(r / 4, d.data(), lanes);
+      for (int a = 0; a < 3; ++a) expect_same_bits(lanes[a][r % 4], want[a], "four_rows_times_points");
+    }
+    // Lanes past the last row are +0.
+    if (rows % 4 != 0) {
+      Lanes<4> lanes[3] = {};
+      sparse.four_rows_times_points<3>(rows / 4, d.data(), lanes);
+      for (std::size_t l = rows % 4; l < 4; ++l)
+        for (int a = 0; a < 3; ++a) expect_same_bits(lanes[a][l], 0.0, "lane past the last row");
     }
   }
 }
