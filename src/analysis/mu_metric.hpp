@@ -107,8 +107,9 @@ double control_lower_bound_of_metric(int dim, const double* m, double err, int s
 
 /// Certified upper bound of R at the subdomain's corners (the vertex control values of W
 /// are values of W): the Rayleigh quotients of W at approximate eigenvectors of W^T W,
-/// evaluated in interval fashion, bound lambda_min from above and lambda_max from below.
-/// Returns min over the corners (<= 1).
+/// evaluated in interval fashion, bound lambda_min from above and lambda_max from below
+/// (2D: the closed-form enclosure of the corner's metric W^T W, with the quotients too
+/// where that bound is below 1e-2). Returns min over the corners (<= 1).
 /// @param seen  optional: the W values (dim x 3, as laid out per corner) of corners already
 ///              bounded with an error bound at most `err`; a corner whose W equals one of
 ///              them bit for bit is skipped (its bound could only be the same or looser),
