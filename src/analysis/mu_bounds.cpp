@@ -310,8 +310,8 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   double delta = 0;
   bool constant = false;
   if (mu_constant_path_enabled()) {
-    delta = constant_w_radius(space, pool.data(), err0);
     const double wmax = largest_magnitude(pool.data(), block);
+    delta = constant_w_radius(space, pool.data(), err0, 1e-9 * wmax);
     constant = delta <= 1e-9 * wmax;
   }
   const int corner = basis.vertex_indices()[0];

@@ -120,12 +120,13 @@ bool eigenvector3(const double* m, double lambda, double* v) {
 void mu_use_constant_path(bool on) noexcept { use_constant_path = on; }
 bool mu_constant_path_enabled() noexcept { return use_constant_path; }
 
-double constant_w_radius(const MuSpace& space, const double* w, double err) {
+double constant_w_radius(const MuSpace& space, const double* w, double err, double stop_above) {
   const auto ws = static_cast<std::size_t>(space.w_size());
   double dev = 0;
   for (int j = 0; j < space.dim() * 3; ++j) {
     const double* p = w + static_cast<std::size_t>(j) * ws;
     for (std::size_t k = 1; k < ws; ++k) dev = std::max(dev, std::abs(p[k] - p[0]));
+    if (dev > stop_above) return std::numeric_limits<double>::infinity();
   }
   // |w_k - w_0| rounded to nearest is within one ulp: next_up covers it (next_up of the
   // largest is the largest next_up, next_up being monotone).

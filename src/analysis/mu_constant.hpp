@@ -4,6 +4,8 @@
 // every control value of W is W itself, so R = lambda_min / lambda_max of one 2x2 or 3x3
 // metric, bounded directly instead of by Bernstein products and bisection (mu_metric.hpp).
 // Internal to src/analysis; used by mu_bounds.cpp.
+#include <limits>
+
 #include "analysis/mu_space.hpp"
 
 namespace quadval {
@@ -18,7 +20,10 @@ bool mu_constant_path_enabled() noexcept;
 /// first one (entrywise): err + max_k |w_k - w_0|, rounded up. Then W(x), a convex
 /// combination of its control values, lies within delta of W_0 everywhere.
 /// @param w, err  as MuMetric::lower_bound
-double constant_w_radius(const MuSpace& space, const double* w, double err);
+/// @param stop_above  +inf instead as soon as max_k |w_k - w_0| exceeds this (a caller that
+///                    only uses small radii: most curved elements stop at W's first entry)
+double constant_w_radius(const MuSpace& space, const double* w, double err,
+                         double stop_above = std::numeric_limits<double>::infinity());
 
 /// Certified lower bound of min R = lambda_min(W^T W) / lambda_max(W^T W) over every
 /// 3 x dim matrix W with |W - W_0| <= delta entrywise; 0 when none can be certified.
