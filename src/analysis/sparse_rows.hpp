@@ -5,7 +5,9 @@
 // row, so the same result bit for bit (a zero entry times a finite difference adds a
 // zero, which leaves a sum started at +0 unchanged), without a multiply or a test per zero.
 // Between 27% (quadratic hexahedra) and 64% (quartic triangles) of the entries are nonzero.
-// Internal to src/analysis.
+// The map is also kept dense in blocks of four rows, summed in SIMD lanes
+// (four_rows_times_points, the same bits again), which is faster where the rows are short
+// chains of additions. Internal to src/analysis.
 
 #include <cstddef>
 #include <cstdint>
