@@ -573,6 +573,12 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // mu 15.6 -> 14.8 ms, sj 15.6 -> 15.3 ms; plate_tri_h0.05 mu 90.6 -> 87.0 ms,
               // sj 125.5 -> 121.0 ms).
               bool margins_known = false;
+              const auto known_margin = [&](std::size_t i) {
+                KnownMargin k;
+                k.margin = margins[i];
+                std::copy_n(betas.begin() + static_cast<std::ptrdiff_t>(3 * i), 3, k.beta.begin());
+                return k;
+              };
               if (const StraightSidedMargin* straight = straight_of[ch.block].get()) {
                 const std::uint64_t ts = stage_ticks();
                 const double* coords = mesh.coords.data();
@@ -609,9 +615,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                     rest[left++] = i;
                     continue;
                   }
-                  KnownMargin known;
-                  known.margin = margins[i];
-                  std::copy_n(betas.begin() + static_cast<std::ptrdiff_t>(3 * i), 3, known.beta.begin());
+                  const KnownMargin known = known_margin(i);
                   finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share,
                                      want_mu || want_sj ? &known : nullptr, tet_lanes ? lane_mu_of(i) : nullptr);
                 }
@@ -654,11 +658,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 ec.bounds = bounds_from_coefficients(space, coeffs.data() + k * s, errors[k], xe,
                                                      report.planar, bo, ws);
                 const std::uint64_t done_at = stage_ticks();
-                KnownMargin known;
-                if (margins_known) {
-                  known.margin = margins[i];
-                  std::copy_n(betas.begin() + static_cast<std::ptrdiff_t>(3 * i), 3, known.beta.begin());
-                }
+                const KnownMargin known = margins_known ? known_margin(i) : KnownMargin{};
                 finish(ch.out + i, xe, batch_share + static_cast<double>(done_at - te), margins_known ? &known : nullptr);
                 te = light_finish ? done_at : stage_ticks();
               }

@@ -78,43 +78,22 @@ double element_w(const MuSpace& space, std::span<const double> x, double* w) {
     }
     flat_z = flat_z && dx[i + 2] == 0;
   }
-  if (range < std::numeric_limits<double>::infinity()) {
-    // Four control points at a time (SparseRows::four_rows_times_points, the same bits).
-    for (std::size_t k0 = 0; k0 < ws; k0 += 4) {
-      Lanes<4> xc[3][3] = {};
-      for (int c = 0; c < dim; ++c) {
-        const SparseRows& map = space.derivative_nonzeros(c);
-        if (flat_z)
-          map.four_rows_times_points<2>(k0 / 4, dx.data(), xc[c]);
-        else
-          map.four_rows_times_points<3>(k0 / 4, dx.data(), xc[c]);
+  // X_c's control values (coordinate a of row k at a * ws + k), then W_j = sum_c Jinv_cj X_c.
+  thread_local std::vector<double> xc;
+  xc.resize(3 * 3 * ws);
+  const bool finite = range < std::numeric_limits<double>::infinity();
+  for (int c = 0; c < dim; ++c)
+    space.derivative_nonzeros(c).times_points(dx.data(), flat_z, finite, xc.data() + static_cast<std::size_t>(c) * 3 * ws);
+  for (int j = 0; j < dim; ++j)
+    for (std::size_t a = 0; a < 3; ++a) {
+      double* out = w + (static_cast<std::size_t>(j) * 3 + a) * ws;
+      for (std::size_t k = 0; k < ws; ++k) {
+        double v = 0;
+        for (int c = 0; c < dim; ++c)
+          v += jinv[static_cast<std::size_t>(c * 3 + j)] * xc[(static_cast<std::size_t>(c) * 3 + a) * ws + k];
+        out[k] = v;
       }
-      for (int j = 0; j < dim; ++j)
-        for (int a = 0; a < 3; ++a) {
-          Lanes<4> v{};
-          for (int c = 0; c < dim; ++c) v += jinv[static_cast<std::size_t>(c * 3 + j)] * xc[c][a];
-          double* out = w + (static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(a)) * ws + k0;
-          for (std::size_t l = 0; l < 4 && k0 + l < ws; ++l) out[l] = v[l];
-        }
     }
-  } else {
-    for (std::size_t k = 0; k < ws; ++k) {
-      double xc[3][3] = {};
-      for (int c = 0; c < dim; ++c) {
-        const SparseRows& map = space.derivative_nonzeros(c);
-        if (flat_z)
-          map.row_times_flat_points(k, dx.data(), xc[c]);
-        else
-          map.row_times_points(k, dx.data(), xc[c]);
-      }
-      for (int j = 0; j < dim; ++j)
-        for (int a = 0; a < 3; ++a) {
-          double v = 0;
-          for (int c = 0; c < dim; ++c) v += jinv[static_cast<std::size_t>(c * 3 + j)] * xc[c][a];
-          w[(static_cast<std::size_t>(j) * 3 + static_cast<std::size_t>(a)) * ws + k] = v;
-        }
-    }
-  }
   double worst = 0;
   for (int j = 0; j < dim; ++j) {
     double s = 0;

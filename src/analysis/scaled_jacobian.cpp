@@ -446,27 +446,11 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
       p.c.resize(rows);
       p.b.e = e;
     }
-    if (range < kInf) {
-      // Four rows at a time (SparseRows::four_rows_times_points, the same bits).
-      for (std::size_t r0 = 0; r0 < rows; r0 += 4) {
-        Lanes<4> sum[3] = {};
-        if (flat_z)
-          m.four_rows_times_points<2>(r0 / 4, values.data(), sum);
-        else
-          m.four_rows_times_points<3>(r0 / 4, values.data(), sum);
-        for (std::size_t j = 0; j < 3; ++j)
-          for (std::size_t l = 0; l < 4 && r0 + l < rows; ++l) col[c][j].c[r0 + l] = sum[j][l];
-      }
-    } else {
-      for (std::size_t r = 0; r < rows; ++r) {
-        double sum[3];
-        if (flat_z)
-          m.row_times_flat_points(r, values.data(), sum);
-        else
-          m.row_times_points(r, values.data(), sum);
-        for (std::size_t j = 0; j < 3; ++j) col[c][j].c[r] = sum[j];
-      }
-    }
+    thread_local std::vector<double> values_by_coordinate;  // coordinate j of row r at j * rows + r
+    values_by_coordinate.resize(3 * rows);
+    m.times_points(values.data(), flat_z, range < kInf, values_by_coordinate.data());
+    for (std::size_t j = 0; j < 3; ++j)
+      std::copy_n(values_by_coordinate.begin() + static_cast<std::ptrdiff_t>(j * rows), rows, col[c][j].c.begin());
     for (std::size_t j = 0; j < 3; ++j) refresh_magnitude(col[c][j]);
   }
 

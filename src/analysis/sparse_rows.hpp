@@ -93,6 +93,36 @@ struct SparseRows {
       for (int a = 0; a < NX; ++a) out[a] += e * d[3 * i + static_cast<std::size_t>(a)];
     }
   }
+
+  std::size_t rows() const { return start.size() - 1; }
+
+  /// Every row times d: out[a * rows() + r] = row_times_points(r, d)[a], where flat (every
+  /// d[3 i + 2] is 0) out[2 * rows() + r] = +0 without computing it. Four rows at a time
+  /// where every d is finite (`finite`: the same bits), row by row otherwise (where a zero
+  /// entry times an infinite d would give NaN).
+  void times_points(const double* d, bool flat, bool finite, double* out) const {
+    const std::size_t n = rows();
+    if (!finite) {
+      for (std::size_t r = 0; r < n; ++r) {
+        double sum[3];
+        if (flat)
+          row_times_flat_points(r, d, sum);
+        else
+          row_times_points(r, d, sum);
+        for (std::size_t a = 0; a < 3; ++a) out[a * n + r] = sum[a];
+      }
+      return;
+    }
+    for (std::size_t r0 = 0; r0 < n; r0 += 4) {
+      Lanes<4> sum[3] = {};
+      if (flat)
+        four_rows_times_points<2>(r0 / 4, d, sum);
+      else
+        four_rows_times_points<3>(r0 / 4, d, sum);
+      for (std::size_t a = 0; a < 3; ++a)
+        for (std::size_t l = 0; l < 4 && r0 + l < n; ++l) out[a * n + r0 + l] = sum[a][l];
+    }
+  }
 };
 
 }  // namespace quadval

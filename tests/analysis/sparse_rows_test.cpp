@@ -61,6 +61,16 @@ void check_map(const std::vector<double>& map, std::size_t rows, std::size_t n, 
         sparse.four_rows_times_points<3>(r / 4, d.data(), lanes);
       for (int a = 0; a < 3; ++a) expect_same_bits(lanes[a][r % 4], want[a], "four_rows_times_points");
     }
+    // All rows at once, by blocks of four and row by row (the path for non-finite points).
+    for (const bool finite : {true, false}) {
+      std::vector<double> all(3 * rows);
+      sparse.times_points(d.data(), flat, finite, all.data());
+      for (std::size_t r = 0; r < rows; ++r) {
+        double want[3];
+        dense_row(map, r, n, d.data(), want);
+        for (std::size_t a = 0; a < 3; ++a) expect_same_bits(all[a * rows + r], want[a], "times_points");
+      }
+    }
     // Lanes past the last row are +0.
     if (rows % 4 != 0) {
       Lanes<4> lanes[3] = {};
