@@ -392,9 +392,9 @@ TEST(CheckStream, CoordinateChecksAndPlanarTest) {
   wide.coords[13] = 5e39;
   EXPECT_NO_THROW(check_mesh(wide, o, "wide.msh"));
 
-  // Past 8 nodes the pass reads blocks of 8 triples, then a tail: 45 nodes (5 blocks and 5
-  // triples), unused nodes added on the plane. Every coordinate, in a block or the tail,
-  // is seen, on its own axis.
+  // The pass reads blocks of kNativeLanes triples (4 or 8), then a tail: 45 nodes (whole
+  // blocks and 1 or 5 triples), unused nodes added on the plane. Every coordinate, in a
+  // block or the tail, is seen, on its own axis.
   Mesh many = mesh;
   many.coords[14] = 2;
   for (int k = 0; k < 40; ++k) {
