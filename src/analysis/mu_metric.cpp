@@ -155,12 +155,47 @@ double MuMetric::control_lower_bound(const MuSpace& space, const double* w, doub
 }
 
 double MuMetric::metric(const MuSpace& space, const double* w, double err, double* out) {
-  metric_entries(space, w, err);
   const int dim = space.dim();
+  const auto size = static_cast<std::size_t>(space.size(2));
+  const BernsteinProduct& p11 = space.prod(1, 1);
+  QV_ASSERT(static_cast<std::size_t>(p11.h_size()) == size, "M's space");
+  // W's columns read where they are and M's entries written straight to `out`, in
+  // kGramEntries order (m00, m11, (m22,) m01, (m02, m12)); the same sums and error bounds
+  // as metric_entries and bound_product, without copying either.
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  const double* columns[9];
+  double mag[9];
+  for (int j = 0; j < dim * 3; ++j) {
+    columns[j] = w + static_cast<std::size_t>(j) * ws;
+    mag[j] = largest_magnitude(columns[j], ws);
+  }
+  const int entries = metric_vectors(dim);
+  double* h[6];
+  for (int e = 0; e < entries; ++e) {
+    h[e] = out + static_cast<std::size_t>(e) * size;
+    std::fill_n(h[e], size, 0.0);
+  }
+  bool flat_z = true;  // planar elements in a plane z = const: W's z coordinates are +0
+  for (int j = 0; j < dim; ++j) flat_z = flat_z && mag[3 * j + 2] == 0;
+  if (p11.gram_sums(columns, dim, h, flat_z ? 2 : 3)) {
+    double bound = 0;
+    for (int e = 0; e < entries; ++e) {
+      const auto [a, b] = dim == 3 ? BernsteinProduct::kGramEntries3[static_cast<std::size_t>(e)]
+                                   : BernsteinProduct::kGramEntries2[static_cast<std::size_t>(e)];
+      double prop = 0, scale_fg = 0;
+      for (int x = 0; x < 3; ++x) {
+        const double fm = mag[3 * a + x], gm = mag[3 * b + x];
+        prop += std::abs(1.0) * (fm * err + err * gm + err * err);
+        scale_fg += std::abs(1.0) * fm * gm;
+      }
+      bound = std::max(bound, (prop + p11.rounding(3) * scale_fg) * kSlack);
+    }
+    return bound;
+  }
+  metric_entries(space, w, err);
   const std::array<int, 6> order = dim == 2 ? std::array<int, 6>{0, 1, 3, 0, 0, 0} : std::array<int, 6>{0, 1, 2, 3, 4, 5};
-  const std::size_t size = m_[0].c.size();
   double e = 0;
-  for (int i = 0; i < metric_vectors(dim); ++i) {
+  for (int i = 0; i < entries; ++i) {
     const Poly& p = m_[order[static_cast<std::size_t>(i)]];
     std::copy(p.c.begin(), p.c.end(), out + static_cast<std::size_t>(i) * size);
     e = std::max(e, p.err);
