@@ -182,11 +182,11 @@ double MuMetric::metric(const MuSpace& space, const double* w, double err, doubl
     for (int e = 0; e < entries; ++e) {
       const auto [a, b] = dim == 3 ? BernsteinProduct::kGramEntries3[static_cast<std::size_t>(e)]
                                    : BernsteinProduct::kGramEntries2[static_cast<std::size_t>(e)];
-      double prop = 0, scale_fg = 0;
+      double prop = 0, scale_fg = 0;  // bound_product's sums, its scales all 1
       for (int x = 0; x < 3; ++x) {
         const double fm = mag[3 * a + x], gm = mag[3 * b + x];
-        prop += std::abs(1.0) * (fm * err + err * gm + err * err);
-        scale_fg += std::abs(1.0) * fm * gm;
+        prop += fm * err + err * gm + err * err;
+        scale_fg += fm * gm;
       }
       bound = std::max(bound, (prop + p11.rounding(3) * scale_fg) * kSlack);
     }
