@@ -95,6 +95,11 @@
 // - Coarser integer costs (fewer distinct dual values): round(q cost) for q = 1e6, 1e4,
 //   1e3, 1e2 instead of 1e9 gave uniform-100k 3.3, 3.0, 1.9, 1.5 s: the trees stay large
 //   even with a hundred cost levels.
+// - A primal warm start: the optimal matching itself, computed by a first solve, offered to
+//   the greedy start (its edges matched first wherever they are tight at y = min c / 2):
+//   uniform-100k 1,364 instead of 1,384 vertices free at the start, 2.8 s instead of 2.6 s.
+//   Most optimal pairs are not tight at those duals; what the solver spends its time on is
+//   finding the duals, not the pairs.
 // Nor did prefetching the records of queued grow events and of dissolving nodes, or keeping
 // each edge's far end and cost beside the vertex, gain beyond the noise (memory-bound, but
 // the loads of one step depend on each other).
