@@ -54,6 +54,12 @@ double ratio_lower_bound(const std::vector<double>& n, double en, const std::vec
 
 thread_local bool use_filter = true;
 
+// The error bound of a sum of `terms` products of `table` (see the top), from the sums
+// prop = sum |s| (F e_g + e_f G + e_f e_g) and scale_fg = sum |s| F G.
+double product_error(const BernsteinProduct& table, int terms, double prop, double scale_fg) {
+  return (prop + table.rounding(terms) * scale_fg) * kSlack;
+}
+
 }  // namespace
 
 void mu_use_filter(bool on) noexcept { use_filter = on; }
@@ -78,7 +84,7 @@ void MuMetric::bound_product(const BernsteinProduct& table,
     prop += std::abs(s) * (f->mag * g->err + f->err * g->mag + f->err * g->err);
     scale_fg += std::abs(s) * f->mag * g->mag;
   }
-  out.err = (prop + table.rounding(static_cast<int>(terms.size())) * scale_fg) * kSlack;
+  out.err = product_error(table, static_cast<int>(terms.size()), prop, scale_fg);
   out.mag = max_abs(out.c);
 }
 
@@ -188,7 +194,7 @@ double MuMetric::metric(const MuSpace& space, const double* w, double err, doubl
         prop += fm * err + err * gm + err * err;
         scale_fg += fm * gm;
       }
-      bound = std::max(bound, (prop + p11.rounding(3) * scale_fg) * kSlack);
+      bound = std::max(bound, product_error(p11, 3, prop, scale_fg));
     }
     return bound;
   }

@@ -1,6 +1,6 @@
 // SparseRows (sparse_rows.hpp) against the dense map it was built from: the same sums bit
-// for bit (one row at a time, and four rows in lanes), on the node maps of real element types and on random maps with zeros and
-// signed zeros.
+// for bit (one row at a time, and four rows in lanes), on the node maps of real element
+// types and on random maps with zeros and signed zeros.
 #include <gtest/gtest.h>
 
 #include <cmath>
