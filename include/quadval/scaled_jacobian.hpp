@@ -70,10 +70,13 @@
 /// their own degrees (convex hull), exact on straight-sided simplices and parallelepipeds;
 /// it settles the straight and barely curved elements that make up most of a curved mesh,
 /// and its bounds tighten the ones below when it does not (src/analysis/
-/// scaled_jacobian_quotient.hpp). On a prism or hexahedron where J <= 0 was found, a
+/// scaled_jacobian_quotient.hpp). On a 3D or planar 2D element where J <= 0 was found, a
 /// signed first stage: sj >= s min(0, min_k min_i J_i / L_k,i) with
 /// L_k = prod_j (v_kj . d_kj) <= prod_j |v_kj| (d_kj unit vectors along the columns' mean
 /// directions; L_k's coefficients proven positive), in J's degree, refined a few times.
+/// Either stage bounds each frame on its own; a frame whose bound is already within the
+/// tolerance of the stage's upper bound is left out of the products and leaves below (on
+/// warped_tetrahedron_o3: 576 of the 1,396 frames of the 349 elements that get there).
 /// Before it, on valid elements, closed forms or fixed-size
 /// formulas: straight-sided simplices (the edges, widened by the straight-sided margin),
 /// bilinear quadrangles in a plane z = const (sj is least at a corner:

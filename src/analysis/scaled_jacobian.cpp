@@ -631,10 +631,12 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   // columns alone, split a few times, settle most elements without the products of twice
   // the degree below; its bounds still count when it does not.
   QualityBounds quick{-kInf, space.s_hi(), 0, false};
+  FrameBounds quick_frames;  // per frame, the first stage's lower bound over the element
+  quick_frames.fill(-kInf);
   if (v == Validity::valid && !area) {
     quick = quotient_bounds(space, quotient_input(polys, udim), options.abs_tol,
                             std::min(kQuotientSplits, options.max_subdivisions),
-                            std::min(kPairedSplits, options.max_subdivisions));
+                            std::min(kPairedSplits, options.max_subdivisions), &quick_frames);
     if (quick.tolerance_met) return quick;
   }
   // Where J <= 0 was found (3D), the signed first stage likewise: J's coefficients with
@@ -642,7 +644,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   if (v == Validity::invalid && (dim == 3 || (dim == 2 && !area))) {
     const QuotientInput in = quotient_input(polys, udim);
     const int splits = std::min(kSignedSplits, options.max_subdivisions);
-    quick = signed_quotient_bounds(space, in, options.abs_tol, splits);
+    quick = signed_quotient_bounds(space, in, options.abs_tol, splits, 0.0, &quick_frames);
     if (quick.tolerance_met) return quick;
     // Not settled, in 2D with the lower bound at the floor -s (a fold: the columns at right
     // angles, the wrong way round): that bound is sharp, and only the upper bound, from the
@@ -654,7 +656,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     const bool at_floor = dim == 2 && quick.lower <= -space.s_hi();
     const double probed = at_floor ? probe_scaled_jacobian(space, in, quick.lower + 0.5 * options.abs_tol).upper : 0.0;
     if (probed < quick.upper) {
-      quick = signed_quotient_bounds(space, in, options.abs_tol, splits, probed);
+      quick = signed_quotient_bounds(space, in, options.abs_tol, splits, probed, &quick_frames);
       if (quick.tolerance_met) return quick;
     }
   }
@@ -684,10 +686,20 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   // |v_a| |v_b| sin, and dividing out leaves nothing below -s).
   const bool hadamard_frames = !valid && dim == 3;
   QV_ASSERT(frames <= LeafFrames::kMax, frames << " frames");
+  // A frame whose first-stage bound is already within the tolerance of that stage's upper
+  // bound (which only decreases) needs nothing more: it is left out of the leaves, its
+  // bound kept aside (as the refinement's closed frames are).
+  std::array<bool, LeafFrames::kMax> done{};
+  double done_lower = kInf;
+  for (std::size_t f = 0; f < frames; ++f) {
+    done[f] = up(quick.upper - quick_frames[f]) <= options.abs_tol;
+    if (done[f]) done_lower = std::min(done_lower, quick_frames[f]);
+  }
   std::array<bool, LeafFrames::kMax> hadamard{};
   auto& had = polys.hadamard;
   had.resize(2 * frames);
   for (std::size_t f = 0; f < frames; ++f) {
+    if (done[f]) continue;
     const Frame& fr = space.frames()[f];
     std::array<std::size_t, 3> d{};
     for (std::size_t j = 0; j < udim; ++j) d[j] = distinct_column(fr, j, udim, polys);
@@ -736,6 +748,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   vectors[nvec++] = &n;
   LeafFrames root_frames;
   for (std::size_t f = 0; f < frames; ++f) {
+    if (done[f]) continue;
     root_frames.width[root_frames.count++] = hadamard[f] ? 3 : 1;
     vectors[nvec++] = &dk[f];
     if (hadamard[f]) {
@@ -763,12 +776,12 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   // valid lets every subdomain skip its own sign test (and leaves hold no J); invalid
   // means a point with J <= 0, where sj <= 0.
   Bounder bounder(space, s2, valid, !area);
-  // Invalid: a point with J <= 0, where sj <= 0, or the signed stage's certified bound.
-  double upper = v == Validity::invalid ? std::min(0.0, quick.upper) : space.s_hi();
+  // Invalid: a point with J <= 0, where sj <= 0; and the first stage's certified bound.
+  double upper = std::min(v == Validity::invalid ? 0.0 : space.s_hi(), quick.upper);
 
   const double tol = options.abs_tol;
   const auto cmp = [](const Leaf& a, const Leaf& b) { return a.lower != b.lower ? a.lower > b.lower : a.id > b.id; };
-  double settled = kInf;  // smallest lower bound of the leaves and frames dropped as good enough
+  double settled = done_lower;  // smallest lower bound of the leaves and frames dropped as good enough
   long next_id = 0;
   // Adds a leaf whose coefficients are at `slot`; frees the slot when it needs no split,
   // and closes the frames that need none (LeafFrames).

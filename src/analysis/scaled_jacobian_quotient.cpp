@@ -264,9 +264,10 @@ class Quotient {
   // Bound on how far a control point's norm moves with its coordinates' errors e.
   static double norm_spread(double e) { return up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12))); }
 
-  // A certified lower bound of sj on the leaf; `upper` is lowered to sj at one of its
-  // corners (the one the squares estimate smallest, per frame), certified there.
-  double bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
+  // A certified lower bound of sj on the leaf, each frame's into frame_lower[k]; `upper`
+  // is lowered to sj at one of its corners (the one the squares estimate smallest, per
+  // frame), certified there.
+  double bound(const double* leaf, const std::array<double, 4>& err, double& upper, FrameBounds& frame_lower) const {
     const std::size_t sj = in_.j.size();
     const double j_lo = down(*std::min_element(leaf, leaf + sj) - err[0]);
     const std::vector<int>& j_corners = layout_.j_tools->corners;
@@ -298,12 +299,14 @@ class Quotient {
       ws_.big[d] = big;
     }
     double lower = kInf;
-    for (const auto& fr : layout_.frames) {
+    for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
+      const auto& fr = layout_.frames[k];
       double norm_product = 1;
       for (std::size_t j = 0; j < dim_; ++j)
         norm_product = up(norm_product * up(up(sqrt_rn(ws_.big[fr[j]]) * (1 + 1e-12)) + ws_.spread[fr[j]]));
       // J > 0 on the element: sj > 0 everywhere, the bound where J_lo is not positive.
-      lower = std::min(lower, j_lo > 0 ? down(space_.s_lo() * down(j_lo / norm_product)) : 0.0);
+      frame_lower[k] = j_lo > 0 ? down(space_.s_lo() * down(j_lo / norm_product)) : 0.0;
+      lower = std::min(lower, frame_lower[k]);
       // The corner of least sj estimated from the squares (any corner gives a true upper
       // bound; the estimate only picks a sharp one), then certified there.
       const auto square_at = [&](std::size_t j, std::size_t m) {
@@ -346,14 +349,18 @@ class Quotient {
   // come from different points, each ratio pairs J and L_k at the same coefficient, and L_k
   // misses prod |v_kj| only by the cosines of the columns' spread on the leaf: the gap
   // shrinks quadratically with the leaf, in the degree of J rather than 2n.
-  double signed_bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
+  double signed_bound(const double* leaf, const std::array<double, 4>& err, double& upper,
+                      FrameBounds& frame_lower_out) const {
     const std::size_t sj = in_.j.size();
     const std::vector<int>& j_corners = layout_.j_tools->corners;
     const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
     const std::size_t corners = j_corners.size();
     // J >= 0 on the whole leaf (every coefficient, its error included): sj >= 0 there, and
     // no corner has J < 0 to bound sj from above; the columns are not needed.
-    if (down(*std::min_element(leaf, leaf + sj) - err[0]) >= 0) return 0.0;
+    if (down(*std::min_element(leaf, leaf + sj) - err[0]) >= 0) {
+      frame_lower_out.fill(0.0);
+      return 0.0;
+    }
     const std::uint32_t unusable = directional_columns(leaf, err, false);
     frame_products(unusable);
     double lower = kInf;
@@ -371,6 +378,7 @@ class Quotient {
           frame_lower = std::max(frame_lower, down(s_hi * bound));
         }
       }
+      frame_lower_out[k] = frame_lower;
       lower = std::min(lower, frame_lower);
       // Upper bounds at the leaf's corners where J < 0 is certain: s J / prod |v_kj| with
       // J at most J + e (negative) and the norms at most their computed values plus spread.
@@ -399,7 +407,8 @@ class Quotient {
   // Errors: R covers the computed V_i's errors and the roundings of the projection
   // (directional_columns); the shifted coefficients a_i + Q carry a's error plus one
   // rounding of the sum; U_k's as L_k's.
-  double paired_bound(const double* leaf, const std::array<double, 4>& err, double& upper) const {
+  double paired_bound(const double* leaf, const std::array<double, 4>& err, double& upper,
+                      FrameBounds& frame_lower_out) const {
     const std::size_t sj = in_.j.size();
     const std::vector<int>& j_corners = layout_.j_tools->corners;
     const double s_hi = space_.s_hi(), s_lo = space_.s_lo();
@@ -423,6 +432,7 @@ class Quotient {
         if (scan.least_den > 0 && least > 0 && least < kInf)
           frame_lower = std::max(frame_lower, down(s_lo * quotient_below(least)));
       }
+      frame_lower_out[k] = frame_lower;
       lower = std::min(lower, frame_lower);
       // Upper bounds at the leaf's corners: s J / prod |v_kj| with J at most J + e and the
       // norms at least their computed values minus spread.
@@ -750,7 +760,7 @@ class Quotient {
 enum class Pairing { none, signs, positive };
 
 QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
-                     Pairing pairing, QualityBounds out);
+                     Pairing pairing, QualityBounds out, FrameBounds* frame_lower);
 
 }  // namespace
 
@@ -761,23 +771,25 @@ thread_local bool use_paired_stage = true;
 void scaled_jacobian_use_paired_stage(bool on) noexcept { use_paired_stage = on; }
 
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                              int max_splits, int max_paired_splits) {
+                              int max_splits, int max_paired_splits, FrameBounds* frame_lower) {
   QualityBounds out;
   out.lower = -kInf;
   out.upper = space.s_hi();
+  if (frame_lower) frame_lower->fill(-kInf);
   if (!(down(*std::min_element(in.j.begin(), in.j.end()) - in.j_error) > 0)) return out;
   if (use_paired_stage && !layout_of(space, in).triple.empty())
-    return refine(space, in, tol, max_paired_splits, Pairing::positive, out);
-  return refine(space, in, tol, max_splits, Pairing::none, out);
+    return refine(space, in, tol, max_paired_splits, Pairing::positive, out, frame_lower);
+  return refine(space, in, tol, max_splits, Pairing::none, out, frame_lower);
 }
 
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                                     int max_splits, double upper) {
+                                     int max_splits, double upper, FrameBounds* frame_lower) {
   QualityBounds out;
   out.lower = -kInf;
   out.upper = std::min(upper, 0.0);  // J <= 0 at a point, where sj <= 0
+  if (frame_lower) frame_lower->fill(-kInf);
   if (layout_of(space, in).triple.empty()) return out;  // L_k outside J's space (2D)
-  return refine(space, in, tol, max_splits, Pairing::signs, out);
+  return refine(space, in, tol, max_splits, Pairing::signs, out, frame_lower);
 }
 
 namespace {
@@ -785,33 +797,40 @@ namespace {
 // Best-first refinement of the leaves' bounds (see Pairing), from `out` holding the bounds
 // known before.
 QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
-                     Pairing pairing, QualityBounds out) {
+                     Pairing pairing, QualityBounds out, FrameBounds* frame_lower) {
   thread_local QuotientScratch scratch;
   const Quotient q(space, in, scratch);
   const std::size_t stride = q.stride();
   thread_local std::vector<double> pool, children;
   thread_local std::vector<std::array<double, 4>> pool_err;
+  thread_local std::vector<FrameBounds> pool_frames;  // per slot: its leaf's frame bounds
   thread_local std::vector<BisectionState> states, child_states;
   thread_local std::vector<int> free_slots;
   thread_local std::vector<Leaf> heap;
   pool.resize(stride);
   pool_err.assign(1, {});
+  pool_frames.resize(1);
   states.assign(1, q.root_state());
   free_slots.clear();
   heap.clear();
   q.root(pool.data(), pool_err[0]);
 
   double settled = kInf;  // least lower bound of the leaves dropped as good enough
+  FrameBounds settled_frames;  // the same per frame
+  settled_frames.fill(kInf);
   long next_id = 0;
   const auto cmp = [](const Leaf& a, const Leaf& b) { return a.lower != b.lower ? a.lower > b.lower : a.id > b.id; };
   const auto push = [&](int slot) {
     const auto s = static_cast<std::size_t>(slot);
     const double* leaf = pool.data() + s * stride;
-    const double lo = pairing == Pairing::signs      ? q.signed_bound(leaf, pool_err[s], out.upper)
-                      : pairing == Pairing::positive ? q.paired_bound(leaf, pool_err[s], out.upper)
-                                                     : q.bound(leaf, pool_err[s], out.upper);
+    FrameBounds& frames = pool_frames[s];
+    frames.fill(kInf);
+    const double lo = pairing == Pairing::signs      ? q.signed_bound(leaf, pool_err[s], out.upper, frames)
+                      : pairing == Pairing::positive ? q.paired_bound(leaf, pool_err[s], out.upper, frames)
+                                                     : q.bound(leaf, pool_err[s], out.upper, frames);
     if (up(out.upper - lo) <= tol) {
       settled = std::min(settled, lo);  // stays good enough: upper only decreases
+      for (std::size_t k = 0; k < frames.size(); ++k) settled_frames[k] = std::min(settled_frames[k], frames[k]);
       free_slots.push_back(slot);
       return;
     }
@@ -858,6 +877,7 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
         slot = static_cast<int>(pool_err.size());
         pool.resize(pool.size() + stride);
         pool_err.emplace_back();
+        pool_frames.emplace_back();
         states.emplace_back();
       }
       const auto s = static_cast<std::size_t>(slot);
@@ -869,9 +889,14 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   }
   out.subdivisions = static_cast<int>((steps + levels - 1) / levels);
   double lower = settled;
-  for (const Leaf& l : heap) lower = std::min(lower, l.lower);
+  for (const Leaf& l : heap) {
+    lower = std::min(lower, l.lower);
+    for (std::size_t k = 0; k < settled_frames.size(); ++k)
+      settled_frames[k] = std::min(settled_frames[k], pool_frames[static_cast<std::size_t>(l.slot)][k]);
+  }
   out.lower = lower;
   out.tolerance_met = up(out.upper - out.lower) <= tol;
+  if (frame_lower) *frame_lower = settled_frames;
   return out;
 }
 

@@ -65,13 +65,20 @@ struct QuotientInput {
   std::size_t coordinates = 3;
 };
 
+/// Per frame k of the space (at most 4): a certified lower bound of the frame's own
+/// pointwise value sj_k (scaled_jacobian.hpp) over the whole element; sj = min_k sj_k.
+using FrameBounds = std::array<double, 4>;
+
 /// Certified bounds of sj(E) on an element where J > 0 is proven, refined best-first until
 /// upper - lower <= tol: in 3D and planar 2D with paired_bound (scaled_jacobian_quotient.cpp)
 /// by at most max_paired_splits splits, otherwise (lines) by at most max_splits. lower = -inf when the root's
 /// least J coefficient is not positive (then nothing is refined); subdivisions counts the
-/// splits; tolerance_met says whether the gap closed.
+/// splits; tolerance_met says whether the gap closed. frame_lower, where given, receives
+/// each frame's lower bound (the least over the final leaves of the frame's bound there;
+/// -inf where nothing was bounded), for the full bounds to leave out the frames already
+/// within the tolerance.
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                              int max_splits, int max_paired_splits);
+                              int max_splits, int max_paired_splits, FrameBounds* frame_lower = nullptr);
 
 /// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D or
 /// planar 2D, with the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's
@@ -79,6 +86,6 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
 /// bound of sj(E), at most 0). Nothing (lower = -inf, upper) where J does not lie in the
 /// space of the product of the columns (none of the 2D and 3D types).
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                                     int max_splits, double upper = 0);
+                                     int max_splits, double upper = 0, FrameBounds* frame_lower = nullptr);
 
 }  // namespace quadval
