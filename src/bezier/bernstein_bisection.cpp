@@ -10,7 +10,7 @@
 #include <tuple>
 #include <utility>
 
-#if defined(__AVX512F__)
+#if defined(__AVX2__)
 #include <immintrin.h>
 #endif
 
@@ -210,6 +210,59 @@ constexpr std::array<RegisterKernel, sizeof...(M)> register_kernels(std::integer
 constexpr std::array<std::array<RegisterKernel, kMaxRegisterLine + 1>, 2> kRegisterKernels = {
     register_kernels<false>(std::make_integer_sequence<int, kMaxRegisterLine + 1>()),
     register_kernels<true>(std::make_integer_sequence<int, kMaxRegisterLine + 1>())};
+#elif defined(__AVX2__)
+// Without AVX-512: the de Casteljau triangle of N <= 4 lanes (lane v: a vector's line or
+// a neighbouring line, its coefficient i at v * size + at[i]) of degree M a constant, so
+// that the triangle is unrolled into registers: no loop exits to mispredict, which cost
+// more than the averages themselves (a degree-12 tetrahedron's 91 lines of 1 to 13
+// coefficients: 3.1 us per halving of one vector with the loops). Lanes past N are zero
+// and never stored. The same averages, in the same order, as casteljau_lanes and the
+// per-vector lanes of bisect() (bit-identical).
+constexpr int kMaxRegisterLine = 16;
+
+template <int M, std::size_t N>
+void casteljau_avx2(const double* src, const std::size_t* at, std::size_t size, double* keep_a, double* keep_b) {
+  static_assert(N >= 1 && N <= 4);
+  const auto load = [&](std::size_t off) {
+    return _mm256_setr_pd(src[off], N > 1 ? src[size + off] : 0.0, N > 2 ? src[2 * size + off] : 0.0,
+                          N > 3 ? src[3 * size + off] : 0.0);
+  };
+  const auto store = [&](double* out, std::size_t off, __m256d x) {
+    const __m128d lo = _mm256_castpd256_pd128(x);
+    _mm_storel_pd(out + off, lo);
+    if constexpr (N > 1) _mm_storeh_pd(out + size + off, lo);
+    if constexpr (N > 2) {
+      const __m128d hi = _mm256_extractf128_pd(x, 1);
+      _mm_storel_pd(out + 2 * size + off, hi);
+      if constexpr (N > 3) _mm_storeh_pd(out + 3 * size + off, hi);
+    }
+  };
+  const __m256d half = _mm256_set1_pd(0.5);
+  __m256d w[M + 1];
+#pragma GCC unroll 17
+  for (int i = 0; i <= M; ++i) w[i] = load(at[i]);
+  store(keep_a, at[0], w[0]);
+  store(keep_b, at[M], w[M]);
+#pragma GCC unroll 16
+  for (int r = 1; r <= M; ++r) {
+#pragma GCC unroll 16
+    for (int i = 0; i + r <= M; ++i) w[i] = _mm256_mul_pd(_mm256_add_pd(w[i], w[i + 1]), half);
+    store(keep_a, at[r], w[0]);
+    store(keep_b, at[M - r], w[M - r]);
+  }
+}
+
+using Avx2Kernel = void (*)(const double*, const std::size_t*, std::size_t, double*, double*);
+template <std::size_t N, int... M>
+constexpr std::array<Avx2Kernel, sizeof...(M)> avx2_kernels(std::integer_sequence<int, M...>) {
+  return {&casteljau_avx2<M, N>...};
+}
+// kAvx2Kernels[N - 1][M]
+constexpr std::array<std::array<Avx2Kernel, kMaxRegisterLine + 1>, 4> kAvx2Kernels = {
+    avx2_kernels<1>(std::make_integer_sequence<int, kMaxRegisterLine + 1>()),
+    avx2_kernels<2>(std::make_integer_sequence<int, kMaxRegisterLine + 1>()),
+    avx2_kernels<3>(std::make_integer_sequence<int, kMaxRegisterLine + 1>()),
+    avx2_kernels<4>(std::make_integer_sequence<int, kMaxRegisterLine + 1>())};
 #endif
 
 }  // namespace
@@ -257,6 +310,14 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
                   src, offset.data(), strided_lanes, static_cast<__mmask8>((1u << width) - 1), ka, kb);
               continue;
             }
+#elif defined(__AVX2__)
+            if (m <= kMaxRegisterLine) {
+              const std::size_t step = side_by_side ? 1 : lane;
+              for (std::size_t h = 0; h < width; h += 4)
+                kAvx2Kernels[std::min<std::size_t>(4, width - h) - 1][static_cast<std::size_t>(m)](
+                    src + h * step, offset.data(), step, ka + h * step, kb + h * step);
+              continue;
+            }
 #endif
             if (side_by_side && width == kRun)
               casteljau_lanes<kRun, true>(src, offset.data(), lane, m, width, ka, kb, w);
@@ -271,20 +332,39 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
     }
     return;
   }
-  // Up to kGroup vectors at once, lane v holding vector v: the same averages per
-  // coefficient as one vector alone (bit-identical), the index work shared and the
-  // averages vectorised across the vectors, over all kGroup lanes (no remainder loop for
-  // the usual 3 to 8 vectors; lanes past the last vector are zeros, never stored).
-  constexpr std::size_t kGroup = 8;
-  alignas(64) std::array<double, kMaxLine * kGroup> w;
+  // Up to G vectors at once, lane v holding vector v: the same averages per coefficient as
+  // one vector alone (bit-identical), the index work shared and the averages vectorised
+  // across the vectors. Lanes past the last vector hold zeros (set once per group: the
+  // averages keep them zero), never stored. Without AVX-512, 4 lanes (one AVX2 register).
+#if defined(__AVX512F__)
+  bisect_vector_lanes<8>(in, count, f, el, keep_a, keep_b);
+#else
+  bisect_vector_lanes<4>(in, count, f, el, keep_a, keep_b);
+#endif
+}
+
+template <std::size_t G>
+void BernsteinBisection::bisect_vector_lanes(const double* in, std::size_t count, std::size_t f, const EdgeLines& el,
+                                             double* keep_a, double* keep_b) const {
+  constexpr std::size_t kMaxLine = 128;
+  const int stride = stride_[f];
+  const auto size = static_cast<std::size_t>(size_);
+  alignas(64) std::array<double, kMaxLine * G> w;
+  std::array<std::size_t, kMaxLine> at;  // a line's coefficient offsets
+  std::size_t longest = 0;
+  for (std::size_t l = 0; l + 1 < el.first.size(); ++l)
+    longest = std::max(longest, static_cast<std::size_t>(el.first[l + 1] - el.first[l]));
+  QV_ASSERT(longest <= kMaxLine, "line of " << longest << " coefficients");
 #if defined(__AVX512F__)
   const LaneOffsets vector_lanes(size);
 #endif
-  for (std::size_t g0 = 0; g0 < count; g0 += kGroup) {
-    const std::size_t n = std::min(kGroup, count - g0);
+  for (std::size_t g0 = 0; g0 < count; g0 += G) {
+    const std::size_t n = std::min(G, count - g0);
 #if defined(__AVX512F__)
     const auto mask = static_cast<__mmask8>((1u << n) - 1);
 #endif
+    for (std::size_t i = 0; i < longest; ++i)
+      for (std::size_t v = n; v < G; ++v) w[i * G + v] = 0.0;
     const double* src = in + g0 * size;
     double* ka = keep_a + g0 * size;
     double* kb = keep_b + g0 * size;
@@ -292,35 +372,40 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
       for (std::size_t l = 0; l + 1 < el.first.size(); ++l) {
         const int* idx = el.index.data() + el.first[l];
         const int m = el.first[l + 1] - el.first[l] - 1;
-        QV_ASSERT(m < static_cast<int>(kMaxLine), "line of degree " << m);
-        const auto at = [&](int i) { return static_cast<std::size_t>(base + stride * idx[i]); };
+        for (int i = 0; i <= m; ++i)
+          at[static_cast<std::size_t>(i)] = static_cast<std::size_t>(base + stride * idx[i]);
 #if defined(__AVX512F__)
         if (m <= kMaxRegisterLine) {
-          std::array<std::size_t, kMaxRegisterLine + 1> offset;
-          for (int i = 0; i <= m; ++i) offset[static_cast<std::size_t>(i)] = at(i);
-          kRegisterKernels[0][static_cast<std::size_t>(m)](src, offset.data(), vector_lanes, mask, ka, kb);
+          kRegisterKernels[0][static_cast<std::size_t>(m)](src, at.data(), vector_lanes, mask, ka, kb);
+          continue;
+        }
+#elif defined(__AVX2__)
+        if (G == 4 && m <= kMaxRegisterLine) {
+          kAvx2Kernels[n - 1][static_cast<std::size_t>(m)](src, at.data(), size, ka, kb);
           continue;
         }
 #endif
-        for (int i = 0; i <= m; ++i)
-          for (std::size_t v = 0; v < kGroup; ++v)
-            w[static_cast<std::size_t>(i) * kGroup + v] = v < n ? src[v * size + at(i)] : 0.0;
+        for (int i = 0; i <= m; ++i) {
+          const std::size_t o = at[static_cast<std::size_t>(i)];
+          for (std::size_t v = 0; v < n; ++v) w[static_cast<std::size_t>(i) * G + v] = src[v * size + o];
+        }
         // Level r of the de Casteljau triangle: w[0] is the keep-a child's coefficient with
         // r midpoints, w[m - r] the keep-b child's with m - r copies of b.
         for (std::size_t v = 0; v < n; ++v) {
-          ka[v * size + at(0)] = w[v];
-          kb[v * size + at(m)] = w[static_cast<std::size_t>(m) * kGroup + v];
+          ka[v * size + at[0]] = w[v];
+          kb[v * size + at[static_cast<std::size_t>(m)]] = w[static_cast<std::size_t>(m) * G + v];
         }
         for (int r = 1; r <= m; ++r) {
           for (int j = 0; j + r <= m; ++j) {
-            double* lo = w.data() + static_cast<std::size_t>(j) * kGroup;
-            const double* hi = lo + kGroup;
+            double* lo = w.data() + static_cast<std::size_t>(j) * G;
+            const double* hi = lo + G;
 #pragma omp simd
-            for (std::size_t v = 0; v < kGroup; ++v) lo[v] = (lo[v] + hi[v]) * 0.5;
+            for (std::size_t v = 0; v < G; ++v) lo[v] = (lo[v] + hi[v]) * 0.5;
           }
+          const std::size_t ra = at[static_cast<std::size_t>(r)], rb = at[static_cast<std::size_t>(m - r)];
           for (std::size_t v = 0; v < n; ++v) {
-            ka[v * size + at(r)] = w[v];
-            kb[v * size + at(m - r)] = w[static_cast<std::size_t>(m - r) * kGroup + v];
+            ka[v * size + ra] = w[v];
+            kb[v * size + rb] = w[static_cast<std::size_t>(m - r) * G + v];
           }
         }
       }

@@ -141,6 +141,10 @@ class BernsteinBisection {
   // a (same layout).
   void bisect(const double* in, std::size_t count, std::size_t f, int a, int b, double* out_keep_a,
               double* out_keep_b) const;
+  // bisect() with the vectors in lanes, G at a time.
+  template <std::size_t G>
+  void bisect_vector_lanes(const double* in, std::size_t count, std::size_t f, const EdgeLines& el,
+                           double* keep_a, double* keep_b) const;
   const EdgeLines& lines(std::size_t f, int a, int b) const {
     return lines_[f][static_cast<std::size_t>(a * 4 + b)];
   }
