@@ -154,6 +154,28 @@ void casteljau_lanes(const double* src, const std::size_t* offset, std::size_t l
   }
 }
 
+#if defined(__AVX2__)
+// The de Casteljau triangle of a line of M + 1 coefficients (M a constant), unrolled for
+// the register kernels below: load(at[i]) gives coefficient i's lanes, store(out, at[i], x)
+// writes them, average(x, y) = (x + y) * 0.5 lane by lane.
+template <int M, class V, class Load, class Store, class Average>
+inline void casteljau_unrolled(const std::size_t* at, Load load, Store store, Average average, double* keep_a,
+                               double* keep_b) {
+  V w[M + 1];
+#pragma GCC unroll 17
+  for (int i = 0; i <= M; ++i) w[i] = load(at[i]);
+  store(keep_a, at[0], w[0]);
+  store(keep_b, at[M], w[M]);
+#pragma GCC unroll 16
+  for (int r = 1; r <= M; ++r) {
+#pragma GCC unroll 16
+    for (int i = 0; i + r <= M; ++i) w[i] = average(w[i], w[i + 1]);
+    store(keep_a, at[r], w[0]);
+    store(keep_b, at[M - r], w[M - r]);
+  }
+}
+#endif
+
 #if defined(__AVX512F__)
 // The de Casteljau triangle of up to 8 parallel lines whose length m + 1 is a constant, so
 // that the whole triangle stays in registers: lane j holds the line whose coefficient i
@@ -188,18 +210,9 @@ void casteljau_registers(const double* src, const std::size_t* at, const LaneOff
                                 x, 8);
   };
   const __m512d half = _mm512_set1_pd(0.5);
-  __m512d w[M + 1];
-#pragma GCC unroll 17
-  for (int i = 0; i <= M; ++i) w[i] = load(at[i]);
-  store(keep_a, at[0], w[0]);
-  store(keep_b, at[M], w[M]);
-#pragma GCC unroll 16
-  for (int r = 1; r <= M; ++r) {
-#pragma GCC unroll 16
-    for (int i = 0; i + r <= M; ++i) w[i] = _mm512_mul_pd(_mm512_add_pd(w[i], w[i + 1]), half);
-    store(keep_a, at[r], w[0]);
-    store(keep_b, at[M - r], w[M - r]);
-  }
+  casteljau_unrolled<M, __m512d>(
+      at, load, store, [&](__m512d x, __m512d y) { return _mm512_mul_pd(_mm512_add_pd(x, y), half); }, keep_a,
+      keep_b);
 }
 
 using RegisterKernel = void (*)(const double*, const std::size_t*, const LaneOffsets&, __mmask8, double*, double*);
@@ -238,18 +251,9 @@ void casteljau_avx2(const double* src, const std::size_t* at, std::size_t size, 
     }
   };
   const __m256d half = _mm256_set1_pd(0.5);
-  __m256d w[M + 1];
-#pragma GCC unroll 17
-  for (int i = 0; i <= M; ++i) w[i] = load(at[i]);
-  store(keep_a, at[0], w[0]);
-  store(keep_b, at[M], w[M]);
-#pragma GCC unroll 16
-  for (int r = 1; r <= M; ++r) {
-#pragma GCC unroll 16
-    for (int i = 0; i + r <= M; ++i) w[i] = _mm256_mul_pd(_mm256_add_pd(w[i], w[i + 1]), half);
-    store(keep_a, at[r], w[0]);
-    store(keep_b, at[M - r], w[M - r]);
-  }
+  casteljau_unrolled<M, __m256d>(
+      at, load, store, [&](__m256d x, __m256d y) { return _mm256_mul_pd(_mm256_add_pd(x, y), half); }, keep_a,
+      keep_b);
 }
 
 using Avx2Kernel = void (*)(const double*, const std::size_t*, std::size_t, double*, double*);
