@@ -311,8 +311,9 @@ const bool kSharedCurvedRegistered = [] {
         ->Arg(1)
         ->Arg(2)
         ->Unit(benchmark::kMicrosecond);
-  for (const char* name : {"hex_box_N20_amp0.35_seed777", "quad_h0.4_o2", "tets_h0.8_o2", "tri_h0.4_o4",
-                           "warped_hexahedron_o2_N6_a0.25", "warped_prism_o2_N6_a0.25",
+  for (const char* name : {"hex_box_N20_amp0.35_seed777", "mixed_h0.6_o2", "quad_h0.4_o2", "tets_h0.8_o2",
+                           "tri_h0.4_o4", "warped_hexahedron_o2_N6_a0.25", "warped_prism_o2_N6_a0.25",
+                           "warped_pyramid_o1_N6_a0.1", "warped_pyramid_o2_N6_a0.15",
                            "warped_tetrahedron_o3_N6_a0.25"})
     benchmark::RegisterBenchmark((std::string("BM_CheckSharedQuality/") + name).c_str(),
                                  [name](benchmark::State& s) { BM_CheckSharedQuality(s, name); })
