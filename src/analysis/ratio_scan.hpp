@@ -1,9 +1,9 @@
 #pragma once
 // The least or largest of the quotients q_i = fl(fl(num_i + a) / fl(den_i + b)) over a
-// vector, bit for bit as the plain loop computes it (with AVX2, a zero's sign aside): with AVX-512, most divisions replaced
-// by approximate reciprocals; else the divisions a vector at a time. Internal to
-// src/analysis (the scaled Jacobian's bounds, where these divisions were most of a
-// subdomain's bound: vdivpd is 8 to 16 times slower than a multiplication).
+// vector, bit for bit as the plain loop computes it (with AVX2, a zero's sign aside): with
+// AVX-512, most divisions replaced by approximate reciprocals; else the divisions a vector
+// at a time. Internal to src/analysis (the scaled Jacobian's bounds, where these divisions
+// were most of a subdomain's bound: vdivpd is 8 to 16 times slower than a multiplication).
 //
 // Why the AVX-512 path gives the same value. Pass 1 approximates each quotient by p_i = n_i * rcp14(d_i),
 // within delta = 2^-14 + 2u relative of n_i / d_i while the p_i are normal numbers. With
