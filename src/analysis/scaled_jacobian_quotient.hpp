@@ -32,6 +32,11 @@
 // settles all invalid elements of warped_hexahedron_o2 and warped_prism_o2 and 540 of the
 // 660 of warped_tetrahedron_o3 within 8 splits (single bisections, as the full bounds);
 // used for every 3D family and for planar 2D elements (scaled_jacobian.cpp).
+// Also tried there: d_kj toward the point of the control points' hull nearest to the
+// origin (Gilbert's algorithm) where the mean direction leaves a projection <= 0. On the
+// slow quadratic tetrahedra of mixed_h0.6_o2 (a column passing 0.004 from zero beside a
+// 0.011 edge) it makes L_k positive, but the projections are then that small and the
+// ratios fall below the Hadamard floor: nothing settled, sj time unchanged.
 //
 // Errors: every coefficient carries an a priori bound (its input's, plus the bisection's
 // rounding_relative() * max|parent| + rounding_absolute() per split); a frame column is a
