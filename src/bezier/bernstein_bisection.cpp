@@ -355,9 +355,8 @@ void BernsteinBisection::bisect_vector_lanes(const double* in, std::size_t count
   const auto size = static_cast<std::size_t>(size_);
   alignas(64) std::array<double, kMaxLine * G> w;
   std::array<std::size_t, kMaxLine> at;  // a line's coefficient offsets
-  std::size_t longest = 0;
-  for (std::size_t l = 0; l + 1 < el.first.size(); ++l)
-    longest = std::max(longest, static_cast<std::size_t>(el.first[l + 1] - el.first[l]));
+  // The longest line along an edge of a simplex factor of degree n: n + 1 coefficients.
+  const auto longest = static_cast<std::size_t>(factors_[f].degree) + 1;
   QV_ASSERT(longest <= kMaxLine, "line of " << longest << " coefficients");
 #if defined(__AVX512F__)
   const LaneOffsets vector_lanes(size);
