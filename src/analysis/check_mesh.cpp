@@ -386,7 +386,9 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     std::vector<std::size_t> rest;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
-    std::vector<QualityBounds> lane_mu;
+    std::vector<QualityBounds> lane_mu, lane_sj;
+    std::vector<double> validity_ticks;
+    std::vector<char> lane_sj_done;
     unsigned lane_mu_done[kLinearChunk / kNativeLanes];
     const Buffer own = batched ? Buffer{} : make_buffer(kFastChunk);  // the largest chunk
     for (;;) {
@@ -448,7 +450,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // mu and the scaled Jacobian of an element whose validity is known (mu given
             // when the chunk's lanes computed it).
             const auto qualities = [&](std::size_t index, const double* xe, Validity v, const KnownMargin* known,
-                                       const QualityBounds* mu_given = nullptr) {
+                                       const QualityBounds* mu_given = nullptr,
+                                       const QualityBounds* sj_given = nullptr) {
               if (want_mu && mu_given) {
                 mu[index] = *mu_given;
                 ++st.mu.computed;
@@ -456,7 +459,11 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 quality(mu_supported(type), mu[index], st.mu, xe, known,
                         [v](const ElementType& t, std::span<const double> x, const QualityOptions& q, bool planar,
                             const KnownMargin* k) { return mu_bounds_given(t, x, q, planar, v, k); });
-              if (want_sj)
+              if (want_sj && sj_given) {
+                sj[index] = *sj_given;
+                ++st.sj.computed;
+                if (!sj_given->tolerance_met) ++st.sj.tolerance_not_met;
+              } else if (want_sj)
                 quality(scaled_jacobian_supported(type), sj[index], st.sj, xe, known,
                         [v](const ElementType& t, std::span<const double> x, const QualityOptions& q, bool planar,
                             const KnownMargin* k) { return scaled_jacobian_bounds_given(t, x, q, planar, v, k); });
@@ -464,13 +471,13 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // What every analysed element gets once its bounds are known.
             // known: the element's straight-sided margin when its chunk computed it.
             const auto finish = [&](std::size_t index, const double* xe, double ticks,
-                                    const KnownMargin* known = nullptr) {
+                                    const KnownMargin* known = nullptr, const QualityBounds* sj_given = nullptr) {
               ElementCheck& ec = elements[index];
               ec.analysed = true;
               const JacobianBounds& b = ec.bounds;
               if (want_distortion)
                 distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws, bo);
-              qualities(index, xe, b.validity, known);
+              qualities(index, xe, b.validity, known, nullptr, sj_given);
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
@@ -637,6 +644,38 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               } else {
                 for (std::size_t i = 0; i < ch.count; ++i) rest[left++] = i;
               }
+              // The scaled Jacobian of the valid elements of `rest` (their nodes in `nodes`,
+              // their validity known), four at a time: lane_sj_done[k] where lane_sj[k] holds
+              // element k's, else it needs the element's own call.
+              const auto planar_sj_lanes = [&] {
+                lane_sj_done.assign(left, 0);
+                lane_sj.resize(left);
+                for (std::size_t k = 0; k < left;) {
+                  std::array<std::size_t, 4> group{};
+                  std::size_t count = 0;
+                  for (; k < left && count < 4; ++k)
+                    if (elements[ch.out + rest[k]].bounds.validity == Validity::valid) group[count++] = k;
+                  if (count == 0) break;
+                  std::array<std::span<const double>, 4> x;
+                  std::array<KnownMargin, 4> known_of{};
+                  std::array<const KnownMargin*, 4> known{};
+                  for (std::size_t l = 0; l < 4; ++l) {
+                    const std::size_t g = group[std::min(l, count - 1)];  // spare lanes: a copy
+                    x[l] = std::span<const double>(nodes.data() + g * nn * 3, nn * 3);
+                    if (margins_known) {
+                      known_of[l] = known_margin(rest[g]);
+                      known[l] = &known_of[l];
+                    }
+                  }
+                  std::array<QualityBounds, 4> out;
+                  const unsigned done = scaled_jacobian_valid_planar4(type, x, qo, known, out);
+                  for (std::size_t l = 0; l < count; ++l)
+                    if ((done >> l) & 1u) {
+                      lane_sj[group[l]] = out[l];
+                      lane_sj_done[group[l]] = 1;
+                    }
+                }
+              };
               nodes.resize(left * nn * 3);
               for (std::size_t k = 0; k < left; ++k) {
                 const auto conn = blk.element(ch.first + rest[k]);
@@ -666,14 +705,34 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // counts in the next element's stage); mu, the scaled Jacobian and distortion
               // in `finish` are kept out of the stage times.
               const bool light_finish = !want_mu && !want_sj && !want_distortion;
+              // The scaled Jacobian of valid planar 2D elements four at a time
+              // (scaled_jacobian_valid_planar4: the same bounds), once the validity of all
+              // of them is known.
+              const bool planar_lanes = want_sj && report.planar && type.dim == 2 && scaled_jacobian_supported(type);
+              if (planar_lanes) {
+                validity_ticks.resize(left);
+                for (std::size_t k = 0; k < left; ++k) {
+                  elements[ch.out + rest[k]].bounds = bounds_from_coefficients(
+                      space, coeffs.data() + k * s, errors[k], nodes.data() + k * nn * 3, report.planar, bo, ws);
+                  const std::uint64_t done_at = stage_ticks();
+                  validity_ticks[k] = batch_share + static_cast<double>(done_at - te);
+                  te = done_at;
+                }
+                planar_sj_lanes();
+              }
               for (std::size_t k = 0; k < left; ++k) {
                 const std::size_t i = rest[k];
                 ElementCheck& ec = elements[ch.out + i];
                 const double* xe = nodes.data() + k * nn * 3;
+                const KnownMargin known = margins_known ? known_margin(i) : KnownMargin{};
+                if (planar_lanes) {
+                  const QualityBounds* given = lane_sj_done[k] ? &lane_sj[k] : nullptr;
+                  finish(ch.out + i, xe, validity_ticks[k], margins_known ? &known : nullptr, given);
+                  continue;
+                }
                 ec.bounds = bounds_from_coefficients(space, coeffs.data() + k * s, errors[k], xe,
                                                      report.planar, bo, ws);
                 const std::uint64_t done_at = stage_ticks();
-                const KnownMargin known = margins_known ? known_margin(i) : KnownMargin{};
                 finish(ch.out + i, xe, batch_share + static_cast<double>(done_at - te), margins_known ? &known : nullptr);
                 te = light_finish ? done_at : stage_ticks();
               }

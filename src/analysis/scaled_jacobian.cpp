@@ -598,6 +598,44 @@ SjProbe scaled_jacobian_probe(const ElementType& type, std::span<const double> n
   return probe_scaled_jacobian(space, element_input(space, nodes, /*planar=*/type.dim == 2), enough);
 }
 
+unsigned scaled_jacobian_valid_planar4(const ElementType& type, const std::array<std::span<const double>, 4>& nodes,
+                                       const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
+                                       std::array<QualityBounds, 4>& out) {
+  QV_ASSERT(scaled_jacobian_supported(type) && type.dim == 2, "four planar elements of " << type.name);
+  const ScaledJacobianSpace& space = scaled_jacobian_space(type);
+  thread_local std::array<Polys, 4> polys;
+  thread_local std::vector<double> values;
+  std::array<QuotientInput, 4> in;
+  unsigned done = 0, lanes = 0;
+  for (std::size_t l = 0; l < 4; ++l) {
+    QV_ASSERT(nodes[l].size() == static_cast<std::size_t>(type.num_nodes) * 3, "nodes " << nodes[l].size());
+    // scaled_jacobian_bounds_given's steps before its first stage.
+    if (const auto straight = straight_simplex_bounds(space, nodes[l], true, options.abs_tol, known[l])) {
+      out[l] = *straight;
+      done |= 1u << l;
+      continue;
+    }
+    if (use_straight_path)
+      if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes[l], options.abs_tol, known[l])) {
+        out[l] = *bilinear;
+        done |= 1u << l;
+        continue;
+      }
+    columns_and_jacobian(space, nodes[l], true, polys[l], values);
+    in[l] = quotient_input(polys[l], 2);
+    lanes |= 1u << l;
+  }
+  if (lanes == 0) return done;
+  const auto first = static_cast<std::size_t>(__builtin_ctz(lanes));
+  for (std::size_t l = 0; l < 4; ++l)
+    if (((lanes >> l) & 1u) == 0) in[l] = in[first];  // a spare lane: a copy
+  std::array<QualityBounds, 4> roots;
+  const unsigned settled = paired_quotient_roots(space, in, options.abs_tol, roots) & lanes;
+  for (std::size_t l = 0; l < 4; ++l)
+    if ((settled >> l) & 1u) out[l] = roots[l];
+  return done | settled;
+}
+
 QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<const double> nodes,
                                            const QualityOptions& options, bool planar, Validity v,
                                            const KnownMargin* known) {

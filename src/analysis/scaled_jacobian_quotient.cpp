@@ -81,6 +81,10 @@ const SpaceTools& tools_of(const std::vector<FactorDegree>& deg) {
   return cache.emplace_back(SpaceTools{key, corner_indices(deg), std::make_unique<BernsteinBisection>(deg)});
 }
 
+// Distinct frame columns of a space at most (a tetrahedron's 6 edges; the bits of an
+// unusable-column mask).
+constexpr std::size_t kMaxDistinct = 12;
+
 // One frame column: the columns it sums, with weights +-1.
 struct FrameColumn {
   std::array<int, 3> column{};
@@ -158,6 +162,7 @@ QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput
       const auto it = std::find_if(q.distinct.begin(), q.distinct.end(), same);
       slots[j] = static_cast<std::size_t>(it - q.distinct.begin());
       if (it == q.distinct.end()) q.distinct.push_back(f);
+      QV_ASSERT(q.distinct.size() <= kMaxDistinct, q.distinct.size() << " frame columns");
     }
     q.frames.push_back(slots);
   }
@@ -204,6 +209,73 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
     if (key == &space) return *layout;
   cache.emplace_back(&space, std::make_unique<QuotientLayout>(make_layout(space, in)));
   return *cache.back().second;
+}
+
+// The steps of directional_columns and paired_bound on one frame column's or one frame's
+// scalars, shared by Quotient and paired_roots4 (the same operations, so the same bits).
+// Their error analysis is at directional_columns and paired_bound.
+
+// Bound on |computed - exact| of each coordinate of frame column f: its columns' errors
+// (err[c + 1]) and the rounding of the sum (gamma_6 of the columns' magnitudes).
+double frame_column_error(const FrameColumn& f, const std::array<double, 4>& err,
+                          const std::array<double, 3>& col_magnitude) {
+  constexpr double gamma = rounding_gamma(6);
+  double e = 0;
+  for (int t = 0; t < f.terms; ++t) {
+    const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
+    e += err[c + 1] + gamma * col_magnitude[c];
+  }
+  return e;
+}
+// Bound on how far a control point's norm moves with its coordinates' errors e.
+double norm_spread(double e) { return up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12))); }
+// A corner's norm from the sum of its squared coordinates: below (the paired bound's
+// corners, J > 0 there) and above (the signed bound's, J < 0).
+double corner_norm_below(double sum, double spread) {
+  return std::max(0.0, down(down(sqrt_rn(sum) * (1 - 1e-12)) - spread));
+}
+double corner_norm_above(double sum, double spread) { return up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread); }
+// At least every computed |V_i|, from the largest |V_i|^2.
+double largest_norm(double big_square) { return up(sqrt_rn(big_square) * (1 + 1e-12)); }
+// Bound on the errors of the dot products V_i . d, the V_i's coordinates within ev and
+// their magnitudes at most mag.
+double along_error(double ev, double mag) { return up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12)); }
+// The shift Q = R / (2 m) of paired_bound's |v| <= a + Q, from the largest |p_i|^2 and
+// |V_i| (vn) and the least a_i; -1 where m is not proven positive or R is not finite.
+double paired_shift(double ev, double vn, double perp_square, double a_min, double along_err) {
+  // R from the largest |p_i| and |V_i| (r grows with both).
+  const double ev3 = up(kSqrt3 * ev);
+  const double pn = up(up(up(sqrt_rn(perp_square) * (1 + 1e-12)) + up(16 * kUnit * vn)) + ev3);
+  const double ve = up(vn + ev3);
+  const double r_max = up(up(pn * pn) + up(4e-15 * up(ve * ve)));
+  const double m = down(a_min - along_err);
+  if (!(m > 0) || !(r_max < kInf)) return -1;
+  return up(r_max / down(2 * m));
+}
+// The shifted coefficients' error: a's, plus one rounding of the sum.
+double shifted_along_error(double along_err, double shifted_big) { return up(along_err + up(2 * kUnit * shifted_big)); }
+// Bound on the errors of a frame's product's coefficients from its factors' magnitudes m
+// and errors e (a third factor 1, error 0, in 2D) and the products' relative rounding.
+double product_error(const std::array<double, 3>& m, const std::array<double, 3>& e, double rounding) {
+  const double mm = m[0] * m[1] * m[2];
+  const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
+  return up((propagated + rounding * mm) * (1 + 1e-10));
+}
+// paired_bound's bound of one frame: J's least coefficient over the largest norms' product,
+// raised by the least quotient of a scan of J_i - e over U_i + e_U where it certifies one.
+double paired_frame_lower(double j_lo, double norm_product, double s_lo, const RatioScan* scan) {
+  double frame_lower = j_lo > 0 ? down(s_lo * down(j_lo / norm_product)) : 0.0;
+  // A positive least quotient means every numerator is positive (rounding keeps signs).
+  if (scan && scan->least_den > 0 && scan->extreme > 0 && scan->extreme < kInf)
+    frame_lower = std::max(frame_lower, down(s_lo * quotient_below(scan->extreme)));
+  return frame_lower;
+}
+// `upper` lowered to s J / prod |v_kj| at a corner of the leaf, with J at most j + e and
+// the norms' product at least norm_product (paired_bound).
+double paired_corner_upper(double j, double e, double norm_product, double s_hi, double upper) {
+  const double j_hi = up(j + e);
+  if (j_hi > 0 && norm_product > 0) upper = std::min(upper, up(s_hi * up(j_hi / norm_product)));
+  return upper;
 }
 
 // Working arrays of Quotient, kept per thread from element to element (as members they
@@ -254,15 +326,8 @@ class Quotient {
   // Bound on |computed - exact| of each coordinate of frame column f: its columns' errors
   // and the rounding of the sum.
   double frame_error(const FrameColumn& f, const std::array<double, 4>& err) const {
-    double e = 0;
-    for (int t = 0; t < f.terms; ++t) {
-      const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
-      e += err[c + 1] + gamma_ * in_.col_magnitude[c];
-    }
-    return e;
+    return frame_column_error(f, err, in_.col_magnitude);
   }
-  // Bound on how far a control point's norm moves with its coordinates' errors e.
-  static double norm_spread(double e) { return up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12))); }
 
   // A certified lower bound of sj on the leaf, each frame's into frame_lower[k]; `upper`
   // is lowered to sj at one of its corners (the one the squares estimate smallest, per
@@ -421,26 +486,22 @@ class Quotient {
       const auto& fr = layout_.frames[k];
       double norm_product = 1;
       for (std::size_t j = 0; j < dim_; ++j) norm_product = up(norm_product * ws_.norm_big[fr[j]]);
-      double frame_lower = j_lo > 0 ? down(s_lo * down(j_lo / norm_product)) : 0.0;
+      // min_i (J_i - e) / (U_i + e_U) without directed roundings (ratio_scan.hpp): each
+      // quotient within three roundings of the exact one.
+      RatioScan scan{};
       if (usable(k, unusable)) {
-        // min_i (J_i - e) / (U_i + e_U) without directed roundings (ratio_scan.hpp): each
-        // quotient within three roundings of the exact one, and a positive least one
-        // means every numerator is positive (rounding keeps signs).
         const double el = frame_product_error(k);
-        const RatioScan scan = scan_ratios<true>(leaf, -err[0], ws_.products.data() + k * sj, el, el, sj);
-        const double least = scan.extreme;
-        if (scan.least_den > 0 && least > 0 && least < kInf)
-          frame_lower = std::max(frame_lower, down(s_lo * quotient_below(least)));
+        scan = scan_ratios<true>(leaf, -err[0], ws_.products.data() + k * sj, el, el, sj);
       }
+      const double frame_lower = paired_frame_lower(j_lo, norm_product, s_lo, usable(k, unusable) ? &scan : nullptr);
       frame_lower_out[k] = frame_lower;
       lower = std::min(lower, frame_lower);
       // Upper bounds at the leaf's corners: s J / prod |v_kj| with J at most J + e and the
       // norms at least their computed values minus spread.
       for (std::size_t mi = 0; mi < corners; ++mi) {
-        const double j_hi = up(leaf[j_corners[mi]] + err[0]);
         double norm_product = 1;
         for (std::size_t j = 0; j < dim_; ++j) norm_product = down(norm_product * ws_.corner_norm_lo[fr[j] * corners + mi]);
-        if (j_hi > 0 && norm_product > 0) upper = std::min(upper, up(s_hi * up(j_hi / norm_product)));
+        upper = paired_corner_upper(leaf[j_corners[mi]], err[0], norm_product, s_hi, upper);
       }
     }
     return lower;
@@ -544,11 +605,10 @@ class Quotient {
         const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
         double sum = 0;
         for (std::size_t x = 0; x < nx; ++x) sum += ws_.part[x * n + at] * ws_.part[x * n + at];
-        const double norm = sqrt_rn(sum);
         if (shifted)
-          ws_.corner_norm_lo[dc * corners + mi] = std::max(0.0, down(down(norm * (1 - 1e-12)) - spread));
+          ws_.corner_norm_lo[dc * corners + mi] = corner_norm_below(sum, spread);
         else
-          ws_.corner_norm[dc * corners + mi] = up(up(norm * (1 + 1e-12)) + spread);
+          ws_.corner_norm[dc * corners + mi] = corner_norm_above(sum, spread);
       }
       const double len = sqrt_rn(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
       if (!(len > 0) || !(len < kInf)) {
@@ -565,29 +625,23 @@ class Quotient {
         project_along<2>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
       else
         project_along<3>(n, d, shifted, along.data(), big, big_square, perp_square, a_min);
-      const double vn = up(sqrt_rn(big_square) * (1 + 1e-12));  // >= every computed |V_i|
+      const double vn = largest_norm(big_square);
       ws_.big[dc] = big;
       ws_.norm_big[dc] = up(vn + spread);
-      ws_.along_err[dc] = up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
+      ws_.along_err[dc] = along_error(ev, mag);
       if (!shifted) continue;
-      // R from the largest |p_i| and |V_i| (r grows with both).
-      const double ev3 = up(kSqrt3 * ev);
-      const double pn = up(up(up(sqrt_rn(perp_square) * (1 + 1e-12)) + up(16 * kUnit * vn)) + ev3);
-      const double ve = up(vn + ev3);
-      const double r_max = up(up(pn * pn) + up(4e-15 * up(ve * ve)));
-      const double m = down(a_min - ws_.along_err[dc]);
-      if (!(m > 0) || !(r_max < kInf)) {
+      const double q = paired_shift(ev, vn, perp_square, a_min, ws_.along_err[dc]);
+      if (q < 0) {
         unusable |= 1u << dc;
         continue;
       }
-      const double q = up(r_max / down(2 * m));
       double shifted_big = 0;
       for (double& a : along) {
         a += q;
         shifted_big = std::max(shifted_big, std::abs(a));
       }
       ws_.big[dc] = shifted_big;
-      ws_.along_err[dc] = up(ws_.along_err[dc] + up(2 * kUnit * shifted_big));
+      ws_.along_err[dc] = shifted_along_error(ws_.along_err[dc], shifted_big);
     }
     return unusable;
   }
@@ -675,9 +729,7 @@ class Quotient {
     const std::array<double, 3> m{ws_.big[fr[0]], ws_.big[fr[1]], dim_ == 3 ? ws_.big[fr[2]] : 1.0};
     const std::array<double, 3> e{ws_.along_err[fr[0]], ws_.along_err[fr[1]], dim_ == 3 ? ws_.along_err[fr[2]] : 0.0};
     // 2D: m_2 = 1 and e_2 = 0 make these the bounds of the two-factor product.
-    const double mm = m[0] * m[1] * m[2];
-    const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
-    return up((propagated + layout_.triple[k].rounding * mm) * (1 + 1e-10));
+    return product_error(m, e, layout_.triple[k].rounding);
   }
 
   // Whether frame k's columns are all usable (directional_columns' bits).
@@ -751,7 +803,6 @@ class Quotient {
   const QuotientInput& in_;
   const QuotientLayout& layout_;
   std::size_t dim_ = 0;
-  const double gamma_ = rounding_gamma(6);  // of a frame column's sum of <= 3 columns
   QuotientScratch& ws_;
 };
 
@@ -900,6 +951,210 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   return out;
 }
 
+// The root of refine's paired stage for four elements at once, element l in lane l of every
+// vector: the steps of directional_columns (shifted) and paired_bound, each lane with the
+// operations the scalar path does on that element (the helpers above, and the same loops
+// over the coefficients in lanes), so the same bits. Where a lane's root meets the
+// tolerance, refine returns exactly those bounds, with no subdivision.
+class PairedRoots {
+ public:
+  static constexpr int kW = 4;
+  using V = Lanes<kW>;
+
+  // The vectors, kept per thread from call to call.
+  struct Scratch {
+    std::vector<V> j, part, products, corner_lo;
+    std::vector<std::vector<V>> along;
+  };
+
+  PairedRoots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, Scratch& ws)
+      : space_(space), in_(in), layout_(layout_of(space, in[0])), j_(ws.j), part_(ws.part), products_(ws.products),
+        corner_lo_(ws.corner_lo), along_(ws.along) {}
+
+  unsigned run(double tol, std::array<QualityBounds, 4>& out) {
+    const std::size_t sj = in_[0].j.size();
+    const std::size_t nd = layout_.distinct.size();
+    const std::vector<int>& j_corners = layout_.j_tools->corners;
+    const std::size_t corners = j_corners.size();
+    const double s_lo = space_.s_lo(), s_hi = space_.s_hi();
+    // quotient_bounds' test: J's least coefficient positive, else lower = -inf there.
+    unsigned open = 0;
+    std::array<std::array<double, 4>, kW> err{};
+    std::array<double, kW> j_lo{};
+    for (std::size_t l = 0; l < kW; ++l) {
+      const QuotientInput& q = in_[l];
+      QV_ASSERT(q.j.size() == sj && q.coordinates == 2, "lanes of another space");
+      err[l] = {q.j_error, q.col_error[0], q.col_error[1], 0};
+      j_lo[l] = down(*std::min_element(q.j.begin(), q.j.end()) - q.j_error);
+      if (j_lo[l] > 0) open |= 1u << l;
+    }
+    if (open == 0) return 0;
+    j_.resize(sj);
+    for (std::size_t i = 0; i < sj; ++i)
+      for (std::size_t l = 0; l < kW; ++l) j_[i][l] = in_[l].j[i];
+    // The frame columns: directional_columns, shifted.
+    std::array<unsigned, kMaxDistinct> unusable{};  // per column: bit l where lane l's is unusable
+    along_.resize(nd);
+    for (std::size_t dc = 0; dc < nd; ++dc) unusable[dc] = column(dc, err, corners);
+    // The frames: paired_bound.
+    std::array<double, kW> lower, upper;
+    lower.fill(kInf);
+    upper.fill(s_hi);
+    for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
+      const auto& fr = layout_.frames[k];
+      const unsigned frame_unusable = unusable[fr[0]] | unusable[fr[1]];
+      std::array<RatioScan, kW> scan{};
+      if ((frame_unusable & open) != open) {
+        products_.resize(sj);
+        if (!layout_.triple[k].first->multiply4(lane_data(along_[fr[0]]), lane_data(along_[fr[1]]),
+                                                reinterpret_cast<double*>(products_.data())))
+          return 0;
+        V a, b;
+        for (std::size_t l = 0; l < kW; ++l) {
+          const std::array<double, 3> m{big_[fr[0]][l], big_[fr[1]][l], 1.0};
+          const std::array<double, 3> e{along_err_[fr[0]][l], along_err_[fr[1]][l], 0.0};
+          a[l] = -err[l][0];
+          b[l] = product_error(m, e, layout_.triple[k].rounding);
+        }
+        // scan_ratios<true>(J, -e, U_k, e_U, e_U): the least quotient and denominator.
+        V least = broadcast_lanes<kW>(kInf), least_den = least;
+        for (std::size_t i = 0; i < sj; ++i) {
+          least = vmin(least, (j_[i] + a) / (products_[i] + b));
+          least_den = vmin(least_den, products_[i] + b);
+        }
+        for (std::size_t l = 0; l < kW; ++l) scan[l] = {least[l], least_den[l]};
+      }
+      for (std::size_t l = 0; l < kW; ++l) {
+        double norm_product = 1;
+        for (std::size_t j = 0; j < 2; ++j) norm_product = up(norm_product * norm_big_[fr[j]][l]);
+        const bool usable = ((frame_unusable >> l) & 1u) == 0;
+        lower[l] = std::min(lower[l], paired_frame_lower(j_lo[l], norm_product, s_lo, usable ? &scan[l] : nullptr));
+        for (std::size_t mi = 0; mi < corners; ++mi) {
+          double corner_product = 1;
+          for (std::size_t j = 0; j < 2; ++j) corner_product = down(corner_product * corner_lo_[fr[j] * corners + mi][l]);
+          upper[l] = paired_corner_upper(in_[l].j[static_cast<std::size_t>(j_corners[mi])], err[l][0], corner_product,
+                                         s_hi, upper[l]);
+        }
+      }
+    }
+    unsigned settled = 0;
+    for (std::size_t l = 0; l < kW; ++l) {
+      if (!((open >> l) & 1u) || !(up(upper[l] - lower[l]) <= tol)) continue;
+      out[l] = {lower[l], upper[l], 0, true};
+      settled |= 1u << l;
+    }
+    return settled;
+  }
+
+ private:
+  // Distinct frame column dc: its dot products with d (shifted) into along_[dc], its
+  // bounds into big_, norm_big_, along_err_, corner_lo_; returns the lanes where it is
+  // unusable.
+  unsigned column(std::size_t dc, const std::array<std::array<double, 4>, kW>& err, std::size_t corners) {
+    const FrameColumn& f = layout_.distinct[dc];
+    const auto c0 = static_cast<std::size_t>(f.column[0]);
+    const std::size_t n = layout_.size[c0];
+    // frame_column: coordinate x of the column at control point i, in lanes.
+    part_.resize(2 * n);
+    std::array<V, 3> mean{};
+    V mag{};
+    for (std::size_t x = 0; x < 2; ++x)
+      for (std::size_t i = 0; i < n; ++i) {
+        V v = V{} + f.weight[0] * column_lanes(f.column[0], x, i);
+        for (int t = 1; t < f.terms; ++t)
+          v = v + f.weight[static_cast<std::size_t>(t)] * column_lanes(f.column[static_cast<std::size_t>(t)], x, i);
+        part_[x * n + i] = v;
+        mean[x] += v;
+        mag = vmax(mag, vabs(v));
+      }
+    std::array<double, kW> ev, spread;
+    for (std::size_t l = 0; l < kW; ++l) {
+      ev[l] = frame_column_error(f, err[l], in_[l].col_magnitude);
+      spread[l] = norm_spread(ev[l]);
+    }
+    corner_lo_.resize(layout_.distinct.size() * corners);
+    for (std::size_t mi = 0; mi < corners; ++mi) {
+      const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
+      V sum{};
+      for (std::size_t x = 0; x < 2; ++x) sum += part_[x * n + at] * part_[x * n + at];
+      for (std::size_t l = 0; l < kW; ++l) corner_lo_[dc * corners + mi][l] = corner_norm_below(sum[l], spread[l]);
+    }
+    unsigned unusable = 0;
+    std::array<V, 3> d{};
+    for (std::size_t l = 0; l < kW; ++l) {
+      const double len = sqrt_rn(mean[0][l] * mean[0][l] + mean[1][l] * mean[1][l] + mean[2][l] * mean[2][l]);
+      if (!(len > 0) || !(len < kInf)) {
+        unusable |= 1u << l;
+        continue;
+      }
+      for (std::size_t x = 0; x < 3; ++x) d[x][l] = mean[x][l] / len * (1 - 1e-15);  // |d| <= 1
+    }
+    // project_along<2>, shifted.
+    std::vector<V>& along = along_[dc];
+    along.resize(n);
+    V big{}, big_square{}, perp_square{}, a_min = broadcast_lanes<kW>(kInf);
+    for (std::size_t i = 0; i < n; ++i) {
+      const V v0 = part_[i], v1 = part_[n + i];
+      const V a = v0 * d[0] + v1 * d[1];
+      const V v2 = v0 * v0 + v1 * v1;
+      along[i] = a;
+      big = vmax(big, vabs(a));
+      big_square = vmax(big_square, v2);
+      a_min = vmin(a_min, a);
+      const V p0 = v0 - a * d[0], p1 = v1 - a * d[1];
+      perp_square = vmax(perp_square, p0 * p0 + p1 * p1);
+    }
+    V q{};
+    for (std::size_t l = 0; l < kW; ++l) {
+      norm_big_[dc][l] = kInf;
+      if ((unusable >> l) & 1u) continue;
+      const double vn = largest_norm(big_square[l]);
+      norm_big_[dc][l] = up(vn + spread[l]);
+      along_err_[dc][l] = along_error(ev[l], mag[l]);
+      q[l] = paired_shift(ev[l], vn, perp_square[l], a_min[l], along_err_[dc][l]);
+      if (q[l] < 0) unusable |= 1u << l;
+    }
+    V shifted_big{};
+    for (V& a : along) {
+      a += q;
+      shifted_big = vmax(shifted_big, vabs(a));
+    }
+    for (std::size_t l = 0; l < kW; ++l) {
+      big_[dc][l] = shifted_big[l];
+      along_err_[dc][l] = shifted_along_error(along_err_[dc][l], shifted_big[l]);
+    }
+    return unusable;
+  }
+
+  // A vector of lanes as multiply4's interleaved coefficients (coefficient i of lane l at 4 i + l).
+  static const double* lane_data(const std::vector<V>& v) { return reinterpret_cast<const double*>(v.data()); }
+
+  // Coefficient i of coordinate x of column c, one element per lane.
+  V column_lanes(int c, std::size_t x, std::size_t i) const {
+    V v;
+    for (std::size_t l = 0; l < kW; ++l) v[l] = in_[l].col[static_cast<std::size_t>(c)][x][i];
+    return v;
+  }
+
+  const ScaledJacobianSpace& space_;
+  const std::array<QuotientInput, 4>& in_;
+  const QuotientLayout& layout_;
+  std::vector<V>&j_, &part_, &products_, &corner_lo_;
+  std::vector<std::vector<V>>& along_;
+  std::array<std::array<double, kW>, kMaxDistinct> big_{}, norm_big_{}, along_err_{};
+};
+
 }  // namespace
+
+unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, double tol,
+                               std::array<QualityBounds, 4>& out) {
+  if (!use_paired_stage || space.dim() != 2) return 0;
+  for (const QuotientInput& q : in)
+    if (q.coordinates != 2 || q.j.size() != in[0].j.size()) return 0;
+  if (layout_of(space, in[0]).triple.empty()) return 0;
+  thread_local PairedRoots::Scratch scratch;
+  PairedRoots roots(space, in, scratch);
+  return roots.run(tol, out);
+}
 
 }  // namespace quadval

@@ -85,6 +85,15 @@ using FrameBounds = std::array<double, 4>;
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
                               int max_splits, int max_paired_splits, FrameBounds* frame_lower = nullptr);
 
+/// quotient_bounds of four planar 2D elements of one space (coordinates = 2) at once, each
+/// in its own SIMD lane, as far as its root: returns bit l where element in[l]'s first stage
+/// meets the tolerance at the root, with out[l] then exactly quotient_bounds(space, in[l],
+/// tol, any, any) (no subdivision); the other lanes' elements need quotient_bounds. Bit l
+/// is also clear wherever the lanes do not apply (other dimensions, a product without
+/// an entry kernel, the tests' switch).
+unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, double tol,
+                               std::array<QualityBounds, 4>& out);
+
 /// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D or
 /// planar 2D, with the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's
 /// signs: refined by at most max_splits best-first splits, from `upper` (a certified upper

@@ -119,4 +119,14 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
                                            const QualityOptions& options, bool planar, Validity v,
                                            const KnownMargin* known = nullptr);
 
+/// scaled_jacobian_bounds_given(type, nodes[l], options, true, Validity::valid, known[l])
+/// for four valid planar 2D elements at once, where it is settled without subdivisions
+/// (closed forms, or the first stage's root in SIMD lanes: paired_quotient_roots in
+/// scaled_jacobian_quotient.hpp): bit l set where out[l] holds exactly that call's result;
+/// the others need the call. A lane's result does not depend on the other lanes (pass an
+/// element twice to fill them). @pre type.dim == 2, every element valid
+unsigned scaled_jacobian_valid_planar4(const ElementType& type, const std::array<std::span<const double>, 4>& nodes,
+                                       const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
+                                       std::array<QualityBounds, 4>& out);
+
 }  // namespace quadval

@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -683,6 +686,60 @@ TEST(ScaledJacobian, PairedStageEnclosesSampledMinimumOnCurvedValidElements) {
   EXPECT_GT(elements, 150u);
   EXPECT_GT(met, elements * 2 / 3);  // 280 of 360: a root beyond 4 tolerances is not refined
   EXPECT_GT(met, 2 * unpaired_met);  // 14
+}
+
+// Four valid planar elements at once (scaled_jacobian_valid_planar4, check_mesh's way):
+// wherever it answers, exactly the bits of the element's own scaled_jacobian_bounds_given,
+// whatever the other lanes hold (a lane's neighbours are shuffled between two runs), and it
+// answers for most curved triangles and quadrangles of orders 2 to 4 (their first stage's
+// root, or a closed form for the few nearly straight ones).
+TEST(ScaledJacobian, FourPlanarElementsInLanesGiveTheirOwnBounds) {
+  std::mt19937 rng(4242);
+  QualityOptions o;
+  o.abs_tol = 1e-2;
+  std::size_t elements = 0, answered = 0;
+  for (const ElementType& t : element_types()) {
+    if (!scaled_jacobian_supported(t) || t.dim != 2 || t.order < 2 || t.order > 4) continue;
+    SCOPED_TRACE(std::string(t.name));
+    std::vector<std::vector<double>> xs;
+    BoundsWorkspace bw;
+    for (int e = 0; xs.size() < 30 && e < 200; ++e) {
+      std::vector<double> x = test::smooth_random_element(t, 0.01 + 0.02 * (e % 4), rng);
+      if (e % 7 == 0) x = test::random_element(t, 0.0, rng);  // straight: a closed form
+      if (jacobian_bounds(t, x, {}, bw, true).validity == Validity::valid) xs.push_back(std::move(x));
+    }
+    ASSERT_GE(xs.size(), 20u);
+    std::vector<QualityBounds> own;
+    for (const auto& x : xs) own.push_back(scaled_jacobian_bounds_given(t, x, o, true, Validity::valid));
+    std::vector<std::size_t> order(xs.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::vector<int> answers(xs.size(), 0);
+    for (int run = 0; run < 2; ++run) {
+      std::shuffle(order.begin(), order.end(), rng);
+      for (std::size_t g = 0; g < order.size(); g += 4) {
+        std::array<std::span<const double>, 4> x;
+        for (std::size_t l = 0; l < 4; ++l) x[l] = xs[order[std::min(g + l, order.size() - 1)]];
+        std::array<QualityBounds, 4> out;
+        const unsigned done = scaled_jacobian_valid_planar4(t, x, o, {}, out);
+        for (std::size_t l = 0; l < 4 && g + l < order.size(); ++l) {
+          if (!((done >> l) & 1u)) continue;
+          const std::size_t i = order[g + l];
+          ++answers[i];
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(out[l].lower), std::bit_cast<std::uint64_t>(own[i].lower)) << i;
+          EXPECT_EQ(std::bit_cast<std::uint64_t>(out[l].upper), std::bit_cast<std::uint64_t>(own[i].upper)) << i;
+          EXPECT_EQ(out[l].subdivisions, own[i].subdivisions) << i;
+          EXPECT_EQ(out[l].tolerance_met, own[i].tolerance_met) << i;
+        }
+      }
+    }
+    for (std::size_t i = 0; i < xs.size(); ++i) {
+      EXPECT_NE(answers[i], 1) << "element " << i << " answered in one run only";
+      elements += 1;
+      answered += answers[i] == 2;
+    }
+  }
+  EXPECT_GT(elements, 150u);
+  EXPECT_GT(answered, elements * 3 / 4);
 }
 
 // The signed first stage (J's coefficients with their signs, over products of the columns
