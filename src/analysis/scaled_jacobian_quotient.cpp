@@ -13,6 +13,7 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/ratio_scan.hpp"
 #include "analysis/sqrt_rn.hpp"
+#include "analysis/symmetric3_lanes.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
@@ -212,15 +213,32 @@ const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const Quotient
 }
 
 // The steps of directional_columns and paired_bound on one frame column's or one frame's
-// scalars, shared by Quotient and paired_roots4 (the same operations, so the same bits).
-// Their error analysis is at directional_columns and paired_bound.
+// scalars, shared by Quotient (T = double) and PairedRoots (T = Lanes<4>, one element per
+// lane): the same operations lane by lane (the lanes' one-ulp steps and square roots are
+// next_up, next_down and sqrt's bits, symmetric3_lanes.hpp), so the same bits. Their error
+// analysis is at directional_columns and paired_bound.
+using Lanes4 = Lanes<4>;
+using Mask4 = lanes3::Mask<4>;
+Lanes4 up(Lanes4 x) { return lanes3::up<4>(x); }
+Lanes4 down(Lanes4 x) { return lanes3::down<4>(x); }
+double root(double x) { return sqrt_rn(x); }
+Lanes4 root(Lanes4 x) { return lanes3::root<4>(x); }
+// c ? a : b, lane by lane for Lanes4.
+template <class C, class T>
+T where(C c, T a, T b) {
+  return c ? a : b;
+}
+template <class T>
+T constant(double v) {
+  return T{} + v;
+}
 
 // Bound on |computed - exact| of each coordinate of frame column f: its columns' errors
 // (err[c + 1]) and the rounding of the sum (gamma_6 of the columns' magnitudes).
-double frame_column_error(const FrameColumn& f, const std::array<double, 4>& err,
-                          const std::array<double, 3>& col_magnitude) {
+template <class T>
+T frame_column_error(const FrameColumn& f, const std::array<T, 4>& err, const std::array<T, 3>& col_magnitude) {
   constexpr double gamma = rounding_gamma(6);
-  double e = 0;
+  T e{};
   for (int t = 0; t < f.terms; ++t) {
     const auto c = static_cast<std::size_t>(f.column[static_cast<std::size_t>(t)]);
     e += err[c + 1] + gamma * col_magnitude[c];
@@ -228,54 +246,76 @@ double frame_column_error(const FrameColumn& f, const std::array<double, 4>& err
   return e;
 }
 // Bound on how far a control point's norm moves with its coordinates' errors e.
-double norm_spread(double e) { return up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12))); }
+template <class T>
+T norm_spread(T e) {
+  return up(kSqrt3 * (1 + 1e-12) * up(e * (1 + 1e-12)));
+}
 // A corner's norm from the sum of its squared coordinates: below (the paired bound's
 // corners, J > 0 there) and above (the signed bound's, J < 0).
-double corner_norm_below(double sum, double spread) {
-  return std::max(0.0, down(down(sqrt_rn(sum) * (1 - 1e-12)) - spread));
+template <class T>
+T corner_norm_below(T sum, T spread) {
+  return vmax(constant<T>(0), down(down(root(sum) * (1 - 1e-12)) - spread));
 }
 double corner_norm_above(double sum, double spread) { return up(up(sqrt_rn(sum) * (1 + 1e-12)) + spread); }
 // At least every computed |V_i|, from the largest |V_i|^2.
-double largest_norm(double big_square) { return up(sqrt_rn(big_square) * (1 + 1e-12)); }
+template <class T>
+T largest_norm(T big_square) {
+  return up(root(big_square) * (1 + 1e-12));
+}
 // Bound on the errors of the dot products V_i . d, the V_i's coordinates within ev and
 // their magnitudes at most mag.
-double along_error(double ev, double mag) { return up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12)); }
+template <class T>
+T along_error(T ev, T mag) {
+  return up(up(kSqrt3 * up(ev + 4 * kUnit * mag)) * (1 + 1e-12));
+}
 // The shift Q = R / (2 m) of paired_bound's |v| <= a + Q, from the largest |p_i|^2 and
 // |V_i| (vn) and the least a_i; -1 where m is not proven positive or R is not finite.
-double paired_shift(double ev, double vn, double perp_square, double a_min, double along_err) {
+template <class T>
+T paired_shift(T ev, T vn, T perp_square, T a_min, T along_err) {
   // R from the largest |p_i| and |V_i| (r grows with both).
-  const double ev3 = up(kSqrt3 * ev);
-  const double pn = up(up(up(sqrt_rn(perp_square) * (1 + 1e-12)) + up(16 * kUnit * vn)) + ev3);
-  const double ve = up(vn + ev3);
-  const double r_max = up(up(pn * pn) + up(4e-15 * up(ve * ve)));
-  const double m = down(a_min - along_err);
-  if (!(m > 0) || !(r_max < kInf)) return -1;
-  return up(r_max / down(2 * m));
+  const T ev3 = up(kSqrt3 * ev);
+  const T pn = up(up(up(root(perp_square) * (1 + 1e-12)) + up(16 * kUnit * vn)) + ev3);
+  const T ve = up(vn + ev3);
+  const T r_max = up(up(pn * pn) + up(4e-15 * up(ve * ve)));
+  const T m = down(a_min - along_err);
+  return where((m > 0) & (r_max < kInf), up(r_max / down(2 * m)), constant<T>(-1));
 }
 // The shifted coefficients' error: a's, plus one rounding of the sum.
-double shifted_along_error(double along_err, double shifted_big) { return up(along_err + up(2 * kUnit * shifted_big)); }
+template <class T>
+T shifted_along_error(T along_err, T shifted_big) {
+  return up(along_err + up(2 * kUnit * shifted_big));
+}
 // Bound on the errors of a frame's product's coefficients from its factors' magnitudes m
 // and errors e (a third factor 1, error 0, in 2D) and the products' relative rounding.
-double product_error(const std::array<double, 3>& m, const std::array<double, 3>& e, double rounding) {
-  const double mm = m[0] * m[1] * m[2];
-  const double propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
+template <class T>
+T product_error(const std::array<T, 3>& m, const std::array<T, 3>& e, double rounding) {
+  const T mm = m[0] * m[1] * m[2];
+  const T propagated = e[0] * (m[1] + e[1]) * (m[2] + e[2]) + m[0] * e[1] * (m[2] + e[2]) + m[0] * m[1] * e[2];
   return up((propagated + rounding * mm) * (1 + 1e-10));
 }
+// quotient_below (ratio_scan.hpp) lane by lane.
+using quadval::quotient_below;
+Lanes4 quotient_below(Lanes4 q) {
+  constexpr double u = 0x1p-53;
+  return down(down(q * where(q < 0, constant<Lanes4>(1 + 4 * u), constant<Lanes4>(1 - 4 * u))) -
+              std::numeric_limits<double>::denorm_min());
+}
 // paired_bound's bound of one frame: J's least coefficient over the largest norms' product,
-// raised by the least quotient of a scan of J_i - e over U_i + e_U where it certifies one.
-double paired_frame_lower(double j_lo, double norm_product, double s_lo, const RatioScan* scan) {
-  double frame_lower = j_lo > 0 ? down(s_lo * down(j_lo / norm_product)) : 0.0;
-  // A positive least quotient means every numerator is positive (rounding keeps signs).
-  if (scan && scan->least_den > 0 && scan->extreme > 0 && scan->extreme < kInf)
-    frame_lower = std::max(frame_lower, down(s_lo * quotient_below(scan->extreme)));
-  return frame_lower;
+// raised, where `scanned`, by the least quotient `least` of a scan of J_i - e over U_i +
+// e_U (least_den its least denominator) where that certifies one: a positive least
+// quotient means every numerator is positive (rounding keeps signs).
+template <class T, class M>
+T paired_frame_lower(T j_lo, T norm_product, double s_lo, M scanned, T least, T least_den) {
+  const T frame_lower = where(j_lo > 0, down(s_lo * down(j_lo / norm_product)), constant<T>(0));
+  return where(scanned & (least_den > 0) & (least > 0) & (least < kInf),
+               vmax(frame_lower, down(s_lo * quotient_below(least))), frame_lower);
 }
 // `upper` lowered to s J / prod |v_kj| at a corner of the leaf, with J at most j + e and
 // the norms' product at least norm_product (paired_bound).
-double paired_corner_upper(double j, double e, double norm_product, double s_hi, double upper) {
-  const double j_hi = up(j + e);
-  if (j_hi > 0 && norm_product > 0) upper = std::min(upper, up(s_hi * up(j_hi / norm_product)));
-  return upper;
+template <class T>
+T paired_corner_upper(T j, T e, T norm_product, double s_hi, T upper) {
+  const T j_hi = up(j + e);
+  return where((j_hi > 0) & (norm_product > 0), vmin(upper, up(s_hi * up(j_hi / norm_product))), upper);
 }
 
 // Working arrays of Quotient, kept per thread from element to element (as members they
@@ -493,7 +533,7 @@ class Quotient {
         const double el = frame_product_error(k);
         scan = scan_ratios<true>(leaf, -err[0], ws_.products.data() + k * sj, el, el, sj);
       }
-      const double frame_lower = paired_frame_lower(j_lo, norm_product, s_lo, usable(k, unusable) ? &scan : nullptr);
+      const double frame_lower = paired_frame_lower(j_lo, norm_product, s_lo, usable(k, unusable), scan.extreme, scan.least_den);
       frame_lower_out[k] = frame_lower;
       lower = std::min(lower, frame_lower);
       // Upper bounds at the leaf's corners: s J / prod |v_kj| with J at most J + e and the
@@ -958,8 +998,8 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
 // tolerance, refine returns exactly those bounds, with no subdivision.
 class PairedRoots {
  public:
-  static constexpr int kW = 4;
-  using V = Lanes<kW>;
+  static constexpr std::size_t kW = 4;
+  using V = Lanes4;
 
   // The vectors, kept per thread from call to call.
   struct Scratch {
@@ -968,8 +1008,7 @@ class PairedRoots {
   };
 
   PairedRoots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, Scratch& ws)
-      : space_(space), in_(in), layout_(layout_of(space, in[0])), j_(ws.j), part_(ws.part), products_(ws.products),
-        corner_lo_(ws.corner_lo), along_(ws.along) {}
+      : space_(space), in_(in), layout_(layout_of(space, in[0])), ws_(ws) {}
 
   unsigned run(double tol, std::array<QualityBounds, 4>& out) {
     const std::size_t sj = in_[0].j.size();
@@ -978,84 +1017,75 @@ class PairedRoots {
     const std::size_t corners = j_corners.size();
     const double s_lo = space_.s_lo(), s_hi = space_.s_hi();
     // quotient_bounds' test: J's least coefficient positive, else lower = -inf there.
-    unsigned open = 0;
-    std::array<std::array<double, 4>, kW> err{};
-    std::array<double, kW> j_lo{};
+    V j_lo;
     for (std::size_t l = 0; l < kW; ++l) {
       const QuotientInput& q = in_[l];
       QV_ASSERT(q.j.size() == sj && q.coordinates == 2, "lanes of another space");
-      err[l] = {q.j_error, q.col_error[0], q.col_error[1], 0};
-      j_lo[l] = down(*std::min_element(q.j.begin(), q.j.end()) - q.j_error);
-      if (j_lo[l] > 0) open |= 1u << l;
+      err_[0][l] = q.j_error;
+      err_[1][l] = q.col_error[0];
+      err_[2][l] = q.col_error[1];
+      magnitude_[0][l] = q.col_magnitude[0];
+      magnitude_[1][l] = q.col_magnitude[1];
+      j_lo[l] = next_down(*std::min_element(q.j.begin(), q.j.end()) - q.j_error);
     }
+    const unsigned open = lanes3::mask_bits<4>(j_lo > 0);
     if (open == 0) return 0;
-    j_.resize(sj);
+    ws_.j.resize(sj);
     for (std::size_t i = 0; i < sj; ++i)
-      for (std::size_t l = 0; l < kW; ++l) j_[i][l] = in_[l].j[i];
+      for (std::size_t l = 0; l < kW; ++l) ws_.j[i][l] = in_[l].j[i];
     // The frame columns: directional_columns, shifted.
-    std::array<unsigned, kMaxDistinct> unusable{};  // per column: bit l where lane l's is unusable
-    along_.resize(nd);
-    for (std::size_t dc = 0; dc < nd; ++dc) unusable[dc] = column(dc, err, corners);
+    std::array<Mask4, kMaxDistinct> usable_column{};
+    ws_.along.resize(nd);
+    ws_.corner_lo.resize(nd * corners);
+    for (std::size_t dc = 0; dc < nd; ++dc) usable_column[dc] = column(dc, corners);
     // The frames: paired_bound.
-    std::array<double, kW> lower, upper;
-    lower.fill(kInf);
-    upper.fill(s_hi);
+    V lower = constant<V>(kInf), upper = constant<V>(s_hi);
+    ws_.products.resize(sj);
     for (std::size_t k = 0; k < layout_.frames.size(); ++k) {
       const auto& fr = layout_.frames[k];
-      const unsigned frame_unusable = unusable[fr[0]] | unusable[fr[1]];
-      std::array<RatioScan, kW> scan{};
-      if ((frame_unusable & open) != open) {
-        products_.resize(sj);
-        if (!layout_.triple[k].first->multiply4(lane_data(along_[fr[0]]), lane_data(along_[fr[1]]),
-                                                reinterpret_cast<double*>(products_.data())))
+      const Mask4 usable = usable_column[fr[0]] & usable_column[fr[1]];
+      // min_i (J_i - e) / (U_i + e_U) as scan_ratios<true> computes it.
+      V least{}, least_den{};
+      if ((lanes3::mask_bits<4>(usable) & open) != 0) {
+        if (!layout_.triple[k].first->multiply4(lane_data(ws_.along[fr[0]]), lane_data(ws_.along[fr[1]]),
+                                                reinterpret_cast<double*>(ws_.products.data())))
           return 0;
-        V a, b;
-        for (std::size_t l = 0; l < kW; ++l) {
-          const std::array<double, 3> m{big_[fr[0]][l], big_[fr[1]][l], 1.0};
-          const std::array<double, 3> e{along_err_[fr[0]][l], along_err_[fr[1]][l], 0.0};
-          a[l] = -err[l][0];
-          b[l] = product_error(m, e, layout_.triple[k].rounding);
-        }
-        // scan_ratios<true>(J, -e, U_k, e_U, e_U): the least quotient and denominator.
-        V least = broadcast_lanes<kW>(kInf), least_den = least;
+        const V a = -err_[0];
+        const V b = product_error<V>({big_[fr[0]], big_[fr[1]], constant<V>(1)},
+                                     {along_err_[fr[0]], along_err_[fr[1]], V{}}, layout_.triple[k].rounding);
+        least = constant<V>(kInf);
+        least_den = least;
         for (std::size_t i = 0; i < sj; ++i) {
-          least = vmin(least, (j_[i] + a) / (products_[i] + b));
-          least_den = vmin(least_den, products_[i] + b);
-        }
-        for (std::size_t l = 0; l < kW; ++l) scan[l] = {least[l], least_den[l]};
-      }
-      for (std::size_t l = 0; l < kW; ++l) {
-        double norm_product = 1;
-        for (std::size_t j = 0; j < 2; ++j) norm_product = up(norm_product * norm_big_[fr[j]][l]);
-        const bool usable = ((frame_unusable >> l) & 1u) == 0;
-        lower[l] = std::min(lower[l], paired_frame_lower(j_lo[l], norm_product, s_lo, usable ? &scan[l] : nullptr));
-        for (std::size_t mi = 0; mi < corners; ++mi) {
-          double corner_product = 1;
-          for (std::size_t j = 0; j < 2; ++j) corner_product = down(corner_product * corner_lo_[fr[j] * corners + mi][l]);
-          upper[l] = paired_corner_upper(in_[l].j[static_cast<std::size_t>(j_corners[mi])], err[l][0], corner_product,
-                                         s_hi, upper[l]);
+          least = vmin(least, (ws_.j[i] + a) / (ws_.products[i] + b));
+          least_den = vmin(least_den, ws_.products[i] + b);
         }
       }
+      const V norm_product = up(up(1 * norm_big_[fr[0]]) * norm_big_[fr[1]]);
+      lower = vmin(lower, paired_frame_lower(j_lo, norm_product, s_lo, usable, least, least_den));
+      for (std::size_t mi = 0; mi < corners; ++mi) {
+        const V corner_product =
+            down(down(1 * ws_.corner_lo[fr[0] * corners + mi]) * ws_.corner_lo[fr[1] * corners + mi]);
+        upper = paired_corner_upper(ws_.j[static_cast<std::size_t>(j_corners[mi])], err_[0], corner_product, s_hi,
+                                    upper);
+      }
     }
-    unsigned settled = 0;
-    for (std::size_t l = 0; l < kW; ++l) {
-      if (!((open >> l) & 1u) || !(up(upper[l] - lower[l]) <= tol)) continue;
-      out[l] = {lower[l], upper[l], 0, true};
-      settled |= 1u << l;
-    }
+    const unsigned settled = open & lanes3::mask_bits<4>(up(upper - lower) <= tol);
+    for (std::size_t l = 0; l < kW; ++l)
+      if ((settled >> l) & 1u) out[l] = {lower[l], upper[l], 0, true};
     return settled;
   }
 
  private:
-  // Distinct frame column dc: its dot products with d (shifted) into along_[dc], its
-  // bounds into big_, norm_big_, along_err_, corner_lo_; returns the lanes where it is
-  // unusable.
-  unsigned column(std::size_t dc, const std::array<std::array<double, 4>, kW>& err, std::size_t corners) {
+  // Distinct frame column dc: its dot products with d, shifted, into ws_.along[dc], its
+  // bounds into big_, norm_big_, along_err_, ws_.corner_lo; returns the lanes where it is
+  // usable.
+  Mask4 column(std::size_t dc, std::size_t corners) {
     const FrameColumn& f = layout_.distinct[dc];
     const auto c0 = static_cast<std::size_t>(f.column[0]);
     const std::size_t n = layout_.size[c0];
-    // frame_column: coordinate x of the column at control point i, in lanes.
-    part_.resize(2 * n);
+    // frame_column: coordinate x of the column at control point i.
+    std::vector<V>& part = ws_.part;
+    part.resize(2 * n);
     std::array<V, 3> mean{};
     V mag{};
     for (std::size_t x = 0; x < 2; ++x)
@@ -1063,70 +1093,53 @@ class PairedRoots {
         V v = V{} + f.weight[0] * column_lanes(f.column[0], x, i);
         for (int t = 1; t < f.terms; ++t)
           v = v + f.weight[static_cast<std::size_t>(t)] * column_lanes(f.column[static_cast<std::size_t>(t)], x, i);
-        part_[x * n + i] = v;
+        part[x * n + i] = v;
         mean[x] += v;
         mag = vmax(mag, vabs(v));
       }
-    std::array<double, kW> ev, spread;
-    for (std::size_t l = 0; l < kW; ++l) {
-      ev[l] = frame_column_error(f, err[l], in_[l].col_magnitude);
-      spread[l] = norm_spread(ev[l]);
-    }
-    corner_lo_.resize(layout_.distinct.size() * corners);
+    const V ev = frame_column_error<V>(f, {err_[0], err_[1], err_[2], V{}}, {magnitude_[0], magnitude_[1], V{}});
+    const V spread = norm_spread(ev);
     for (std::size_t mi = 0; mi < corners; ++mi) {
       const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
       V sum{};
-      for (std::size_t x = 0; x < 2; ++x) sum += part_[x * n + at] * part_[x * n + at];
-      for (std::size_t l = 0; l < kW; ++l) corner_lo_[dc * corners + mi][l] = corner_norm_below(sum[l], spread[l]);
+      for (std::size_t x = 0; x < 2; ++x) sum += part[x * n + at] * part[x * n + at];
+      ws_.corner_lo[dc * corners + mi] = corner_norm_below(sum, spread);
     }
-    unsigned unusable = 0;
-    std::array<V, 3> d{};
-    for (std::size_t l = 0; l < kW; ++l) {
-      const double len = sqrt_rn(mean[0][l] * mean[0][l] + mean[1][l] * mean[1][l] + mean[2][l] * mean[2][l]);
-      if (!(len > 0) || !(len < kInf)) {
-        unusable |= 1u << l;
-        continue;
-      }
-      for (std::size_t x = 0; x < 3; ++x) d[x][l] = mean[x][l] / len * (1 - 1e-15);  // |d| <= 1
-    }
+    const V len = root(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
+    Mask4 usable = (len > 0) & (len < kInf);
+    std::array<V, 2> d;
+    for (std::size_t x = 0; x < 2; ++x) d[x] = where(usable, mean[x] / len * (1 - 1e-15), V{});  // |d| <= 1
     // project_along<2>, shifted.
-    std::vector<V>& along = along_[dc];
+    std::vector<V>& along = ws_.along[dc];
     along.resize(n);
-    V big{}, big_square{}, perp_square{}, a_min = broadcast_lanes<kW>(kInf);
+    V big{}, big_square{}, perp_square{}, a_min = constant<V>(kInf);
     for (std::size_t i = 0; i < n; ++i) {
-      const V v0 = part_[i], v1 = part_[n + i];
+      const V v0 = part[i], v1 = part[n + i];
       const V a = v0 * d[0] + v1 * d[1];
-      const V v2 = v0 * v0 + v1 * v1;
       along[i] = a;
       big = vmax(big, vabs(a));
-      big_square = vmax(big_square, v2);
+      big_square = vmax(big_square, v0 * v0 + v1 * v1);
       a_min = vmin(a_min, a);
       const V p0 = v0 - a * d[0], p1 = v1 - a * d[1];
       perp_square = vmax(perp_square, p0 * p0 + p1 * p1);
     }
-    V q{};
-    for (std::size_t l = 0; l < kW; ++l) {
-      norm_big_[dc][l] = kInf;
-      if ((unusable >> l) & 1u) continue;
-      const double vn = largest_norm(big_square[l]);
-      norm_big_[dc][l] = up(vn + spread[l]);
-      along_err_[dc][l] = along_error(ev[l], mag[l]);
-      q[l] = paired_shift(ev[l], vn, perp_square[l], a_min[l], along_err_[dc][l]);
-      if (q[l] < 0) unusable |= 1u << l;
-    }
+    const V vn = largest_norm(big_square);
+    norm_big_[dc] = where(usable, up(vn + spread), constant<V>(kInf));
+    along_err_[dc] = along_error(ev, mag);
+    const V q = paired_shift(ev, vn, perp_square, a_min, along_err_[dc]);
+    usable &= q >= 0;
     V shifted_big{};
     for (V& a : along) {
       a += q;
       shifted_big = vmax(shifted_big, vabs(a));
     }
-    for (std::size_t l = 0; l < kW; ++l) {
-      big_[dc][l] = shifted_big[l];
-      along_err_[dc][l] = shifted_along_error(along_err_[dc][l], shifted_big[l]);
-    }
-    return unusable;
+    big_[dc] = shifted_big;
+    along_err_[dc] = shifted_along_error(along_err_[dc], shifted_big);
+    return usable;
   }
 
-  // A vector of lanes as multiply4's interleaved coefficients (coefficient i of lane l at 4 i + l).
+  // A vector of lanes as multiply4's interleaved coefficients (coefficient i of lane l at
+  // 4 i + l).
   static const double* lane_data(const std::vector<V>& v) { return reinterpret_cast<const double*>(v.data()); }
 
   // Coefficient i of coordinate x of column c, one element per lane.
@@ -1139,9 +1152,10 @@ class PairedRoots {
   const ScaledJacobianSpace& space_;
   const std::array<QuotientInput, 4>& in_;
   const QuotientLayout& layout_;
-  std::vector<V>&j_, &part_, &products_, &corner_lo_;
-  std::vector<std::vector<V>>& along_;
-  std::array<std::array<double, kW>, kMaxDistinct> big_{}, norm_big_{}, along_err_{};
+  Scratch& ws_;
+  std::array<V, 3> err_{};        // J's, then each column's error bound
+  std::array<V, 2> magnitude_{};  // each column's magnitude
+  std::array<V, kMaxDistinct> big_{}, norm_big_{}, along_err_{};
 };
 
 }  // namespace
