@@ -598,39 +598,124 @@ SjProbe scaled_jacobian_probe(const ElementType& type, std::span<const double> n
   return probe_scaled_jacobian(space, element_input(space, nodes, /*planar=*/type.dim == 2), enough);
 }
 
+// columns_and_jacobian of four valid planar elements in planes z = const, element l in lane
+// l of every vector, for paired_quotient_roots: the same operations lane by lane, so the
+// same bits as each element's own QuotientInput (SparseRows::rows_times_planar_lanes,
+// BernsteinProduct::multiply_add_sum2x4; in z = const, J = c_0 x c_1 . (0, 0, 1) is the
+// cross product's z term, whose x and y terms are products of zeros). false where that does
+// not apply (an element off a plane z = const, a coordinate or bound not finite, a product
+// without the entry kernel): then the elements' own calls.
+struct PlanarLanes {
+  using V = Lanes<4>;
+  std::vector<V> d, jac;
+  std::array<std::vector<V>, 2> col;  // column c: its x coefficients, then its y
+  std::vector<FactorDegree> j_degrees;
+};
+
+bool planar_lanes_input(const ScaledJacobianSpace& space, const std::array<std::span<const double>, 4>& nodes,
+                        PlanarLanes& ws, QuotientLanes& in) {
+  using V = PlanarLanes::V;
+  const ElementType& type = space.type();
+  const auto nn = static_cast<std::size_t>(type.num_nodes);
+  // 1. The node differences x_i - x_0 and their range, as columns_and_jacobian takes them.
+  ws.d.resize(2 * nn);
+  V range{};
+  for (std::size_t l = 0; l < 4; ++l) {
+    const double* x = nodes[l].data();
+    double r = 0;
+    for (std::size_t i = 0; i < nn; ++i) {
+      for (std::size_t j = 0; j < 3; ++j) r = std::max(r, std::abs(x[3 * i + j] - x[j]));
+      if (x[3 * i + 2] - x[2] != 0) return false;
+      ws.d[2 * i][l] = x[3 * i] - x[0];
+      ws.d[2 * i + 1][l] = x[3 * i + 1] - x[1];
+    }
+    if (!(r < kInf)) return false;
+    range[l] = r;
+  }
+  // 2. The columns' coefficients, error bounds and magnitudes (z: zeros, magnitude 0).
+  std::array<V, 2> err, mag_x, mag_y;
+  for (std::size_t c = 0; c < 2; ++c) {
+    const auto rows = static_cast<std::size_t>(space.column_size(static_cast<int>(c)));
+    const double factor = (6 * kUnit + rounding_gamma(type.num_nodes)) * space.column_row_sum(static_cast<int>(c));
+    err[c] = factor * range * 1.01;
+    ws.col[c].resize(2 * rows);
+    space.column_nonzeros(static_cast<int>(c)).rows_times_planar_lanes(ws.d.data(), ws.col[c].data());
+    mag_x[c] = mag_y[c] = V{};
+    for (std::size_t r = 0; r < rows; ++r) {
+      mag_x[c] = vmax(mag_x[c], vabs(ws.col[c][r]));
+      mag_y[c] = vmax(mag_y[c], vabs(ws.col[c][rows + r]));
+    }
+    in.col[c][0] = std::span<const V>(ws.col[c].data(), rows);
+    in.col[c][1] = std::span<const V>(ws.col[c].data() + rows, rows);
+    in.col_degrees[c] = &space.column_degrees(static_cast<int>(c));
+    in.col_error[c] = vmax(vmax(vmax(V{}, err[c]), err[c]), err[c]);
+    in.col_magnitude[c] = vmax(vmax(vmax(V{}, mag_x[c]), mag_y[c]), V{});
+  }
+  // 3. J = 0 + c_0,x c_1,y - c_0,y c_1,x (product_sum, then linear_sum with (0, 0, 1)).
+  const BernsteinProduct& table = bernstein_product(space.column_degrees(0), space.column_degrees(1));
+  ws.jac.assign(static_cast<std::size_t>(table.h_size()), V{});
+  const auto lanes = [](const std::vector<V>& v, std::size_t at) { return reinterpret_cast<const double*>(v.data() + at); };
+  const std::size_t r0 = in.col[0][0].size(), r1 = in.col[1][0].size();
+  // product_sum leaves J +0 where every term has a factor zero everywhere: not in lanes.
+  const auto zero_everywhere = ((mag_x[0] == 0) | (mag_y[1] == 0)) & ((mag_y[0] == 0) | (mag_x[1] == 0));
+  for (std::size_t l = 0; l < 4; ++l)
+    if (zero_everywhere[l] != 0) return false;
+  if (!table.multiply_add_sum2x4(1.0, lanes(ws.col[0], 0), lanes(ws.col[1], r1), -1.0, lanes(ws.col[0], r0),
+                                 lanes(ws.col[1], 0), reinterpret_cast<double*>(ws.jac.data())))
+    return false;
+  V w_mag{};
+  for (V& c : ws.jac) {
+    w_mag = vmax(w_mag, vabs(c));
+    c = V{} + c;
+  }
+  // product_sum's error bounds of the cross product's three terms (factors' magnitudes and
+  // errors; z: 0 and the columns' error), then linear_sum's with weights 0, 0, 1.
+  const double rounding = table.rounding(2);
+  const auto cross_error = [&](V fm0, V gm0, V fm1, V gm1) {
+    const V magnitude = (V{} + 1.0 * fm0 * gm0) + 1.0 * fm1 * gm1;
+    const V propagated = (V{} + 1.0 * (fm0 * err[1] + (gm0 + err[1]) * err[0])) + 1.0 * (fm1 * err[1] + (gm1 + err[1]) * err[0]);
+    return propagated + rounding * magnitude;
+  };
+  const V e0 = cross_error(mag_y[0], V{}, V{}, mag_y[1]);  // c_0,y c_1,z - c_0,z c_1,y
+  const V e1 = cross_error(V{}, mag_x[1], mag_x[0], V{});  // c_0,z c_1,x - c_0,x c_1,z
+  const V e2 = cross_error(mag_x[0], mag_y[1], mag_y[0], mag_x[1]);
+  const V e = ((V{} + 0.0 * e0) + 0.0 * e1) + 1.0 * e2;
+  const V m = ((V{} + 0.0 * V{}) + 0.0 * V{}) + 1.0 * w_mag;
+  in.j_error = e + rounding_gamma(6) * m;
+  for (std::size_t l = 0; l < 4; ++l)
+    if (!(in.j_error[l] < kInf) || !(in.col_magnitude[0][l] < kInf) || !(in.col_magnitude[1][l] < kInf)) return false;
+  const auto h = table.h_degrees();
+  ws.j_degrees.assign(h.begin(), h.end());
+  in.j = ws.jac;
+  in.j_degrees = &ws.j_degrees;
+  return true;
+}
+
 unsigned scaled_jacobian_valid_planar4(const ElementType& type, const std::array<std::span<const double>, 4>& nodes,
                                        const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
                                        std::array<QualityBounds, 4>& out) {
   QV_ASSERT(scaled_jacobian_supported(type) && type.dim == 2, "four planar elements of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
-  thread_local std::array<Polys, 4> polys;
-  thread_local std::vector<double> values;
-  std::array<QuotientInput, 4> in;
-  unsigned done = 0, lanes = 0;
+  unsigned done = 0;
   for (std::size_t l = 0; l < 4; ++l) {
     QV_ASSERT(nodes[l].size() == static_cast<std::size_t>(type.num_nodes) * 3, "nodes " << nodes[l].size());
     // scaled_jacobian_bounds_given's steps before its first stage.
     if (const auto straight = straight_simplex_bounds(space, nodes[l], true, options.abs_tol, known[l])) {
       out[l] = *straight;
       done |= 1u << l;
-      continue;
-    }
-    if (use_straight_path)
+    } else if (use_straight_path) {
       if (const auto bilinear = bilinear_quad_sj_bounds(type, nodes[l], options.abs_tol, known[l])) {
         out[l] = *bilinear;
         done |= 1u << l;
-        continue;
       }
-    columns_and_jacobian(space, nodes[l], true, polys[l], values);
-    in[l] = quotient_input(polys[l], 2);
-    lanes |= 1u << l;
+    }
   }
-  if (lanes == 0) return done;
-  const auto first = static_cast<std::size_t>(__builtin_ctz(lanes));
-  for (std::size_t l = 0; l < 4; ++l)
-    if (((lanes >> l) & 1u) == 0) in[l] = in[first];  // a spare lane: a copy
+  if (done == 15) return done;
+  thread_local PlanarLanes ws;
+  QuotientLanes in;
+  if (!planar_lanes_input(space, nodes, ws, in)) return done;
   std::array<QualityBounds, 4> roots;
-  const unsigned settled = paired_quotient_roots(space, in, options.abs_tol, roots) & lanes;
+  const unsigned settled = paired_quotient_roots(space, in, options.abs_tol, roots) & ~done & 15u;
   for (std::size_t l = 0; l < 4; ++l)
     if ((settled >> l) & 1u) out[l] = roots[l];
   return done | settled;

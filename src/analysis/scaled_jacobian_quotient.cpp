@@ -126,16 +126,31 @@ struct QuotientLayout {
   bool shared_tables = false;
 };
 
-QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput& in) {
+// What a layout depends on of an input: its degrees and sizes.
+struct InputShape {
+  const std::vector<FactorDegree>* j_degrees = nullptr;
+  std::size_t j_size = 0;
+  std::array<const std::vector<FactorDegree>*, 3> col_degrees{};
+  std::array<std::size_t, 3> col_size{};
+};
+InputShape shape_of(const QuotientInput& in) {
+  return {in.j_degrees, in.j.size(), in.col_degrees, {in.col[0][0].size(), in.col[1][0].size(), in.col[2][0].size()}};
+}
+InputShape shape_of(const QuotientLanes& in) {
+  return {in.j_degrees, in.j.size(), {in.col_degrees[0], in.col_degrees[1], nullptr},
+          {in.col[0][0].size(), in.col[1][0].size(), 0}};
+}
+
+QuotientLayout make_layout(const ScaledJacobianSpace& space, const InputShape& in) {
   QuotientLayout q;
   const auto dim = static_cast<std::size_t>(space.dim());
   QV_ASSERT(dim >= 1 && dim <= 3, "dimension " << dim);
   q.j_tools = &tools_of(*in.j_degrees);
-  std::size_t at = in.j.size();
+  std::size_t at = in.j_size;
   for (std::size_t c = 0; c < dim; ++c) {
     q.col_tools[c] = &tools_of(*in.col_degrees[c]);
     q.offset[c + 1] = at;
-    q.size[c] = in.col[c][0].size();
+    q.size[c] = in.col_size[c];
     at += 3 * q.size[c];
     QV_ASSERT(q.col_tools[c]->corners.size() == q.j_tools->corners.size(), "corner counts differ");
   }
@@ -204,7 +219,7 @@ QuotientLayout make_layout(const ScaledJacobianSpace& space, const QuotientInput
 }
 
 // The layout of a space, built once per thread.
-const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const QuotientInput& in) {
+const QuotientLayout& layout_of(const ScaledJacobianSpace& space, const InputShape& in) {
   thread_local std::vector<std::pair<const ScaledJacobianSpace*, std::unique_ptr<QuotientLayout>>> cache;
   for (const auto& [key, layout] : cache)
     if (key == &space) return *layout;
@@ -333,7 +348,7 @@ struct QuotientScratch {
 class Quotient {
  public:
   Quotient(const ScaledJacobianSpace& space, const QuotientInput& in, QuotientScratch& ws)
-      : space_(space), in_(in), layout_(layout_of(space, in)), ws_(ws) {
+      : space_(space), in_(in), layout_(layout_of(space, shape_of(in))), ws_(ws) {
     dim_ = static_cast<std::size_t>(space.dim());
     QV_ASSERT(layout_.offset[1] == in.j.size() && layout_.size[0] == in.col[0][0].size(),
               "the layout of another input");
@@ -868,7 +883,7 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
   out.upper = space.s_hi();
   if (frame_lower) frame_lower->fill(-kInf);
   if (!(down(*std::min_element(in.j.begin(), in.j.end()) - in.j_error) > 0)) return out;
-  if (use_paired_stage && !layout_of(space, in).triple.empty())
+  if (use_paired_stage && !layout_of(space, shape_of(in)).triple.empty())
     return refine(space, in, tol, max_paired_splits, Pairing::positive, out, frame_lower);
   return refine(space, in, tol, max_splits, Pairing::none, out, frame_lower);
 }
@@ -879,7 +894,7 @@ QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const Quo
   out.lower = -kInf;
   out.upper = std::min(upper, 0.0);  // J <= 0 at a point, where sj <= 0
   if (frame_lower) frame_lower->fill(-kInf);
-  if (layout_of(space, in).triple.empty()) return out;  // L_k outside J's space (2D)
+  if (layout_of(space, shape_of(in)).triple.empty()) return out;  // L_k outside J's space (2D)
   return refine(space, in, tol, max_splits, Pairing::signs, out, frame_lower);
 }
 
@@ -1003,41 +1018,35 @@ class PairedRoots {
 
   // The vectors, kept per thread from call to call.
   struct Scratch {
-    std::vector<V> j, part, products, corner_lo;
+    std::vector<V> part, products, corner_lo;
     std::vector<std::vector<V>> along;
   };
 
-  PairedRoots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, Scratch& ws)
-      : space_(space), in_(in), layout_(layout_of(space, in[0])), ws_(ws) {}
+  PairedRoots(const ScaledJacobianSpace& space, const QuotientLanes& in, Scratch& ws)
+      : space_(space), in_(in), layout_(layout_of(space, shape_of(in))), ws_(ws) {
+    QV_ASSERT(layout_.offset[1] == in.j.size() && layout_.size[0] == in.col[0][0].size(), "the layout of another input");
+  }
 
   unsigned run(double tol, std::array<QualityBounds, 4>& out) {
-    const std::size_t sj = in_[0].j.size();
+    const std::span<const V> j = in_.j;
+    const std::size_t sj = j.size();
     const std::size_t nd = layout_.distinct.size();
     const std::vector<int>& j_corners = layout_.j_tools->corners;
     const std::size_t corners = j_corners.size();
     const double s_lo = space_.s_lo(), s_hi = space_.s_hi();
-    // quotient_bounds' test: J's least coefficient positive, else lower = -inf there.
-    V j_lo;
-    for (std::size_t l = 0; l < kW; ++l) {
-      const QuotientInput& q = in_[l];
-      QV_ASSERT(q.j.size() == sj && q.coordinates == 2, "lanes of another space");
-      err_[0][l] = q.j_error;
-      err_[1][l] = q.col_error[0];
-      err_[2][l] = q.col_error[1];
-      magnitude_[0][l] = q.col_magnitude[0];
-      magnitude_[1][l] = q.col_magnitude[1];
-      j_lo[l] = next_down(*std::min_element(q.j.begin(), q.j.end()) - q.j_error);
-    }
+    err_ = {in_.j_error, in_.col_error[0], in_.col_error[1]};
+    // quotient_bounds' test: J's least coefficient positive (min_element's value: the first
+    // of the least), else lower = -inf there.
+    V j_min = constant<V>(kInf);
+    for (const V& c : j) j_min = vmin(j_min, c);
+    const V j_lo = down(j_min - in_.j_error);
     const unsigned open = lanes3::mask_bits<4>(j_lo > 0);
     if (open == 0) return 0;
-    ws_.j.resize(sj);
-    for (std::size_t i = 0; i < sj; ++i)
-      for (std::size_t l = 0; l < kW; ++l) ws_.j[i][l] = in_[l].j[i];
     // The frame columns: directional_columns, shifted.
     std::array<Mask4, kMaxDistinct> usable_column{};
     ws_.along.resize(nd);
     ws_.corner_lo.resize(nd * corners);
-    for (std::size_t dc = 0; dc < nd; ++dc) usable_column[dc] = column(dc, corners);
+    for (std::size_t dc = 0; dc < nd; ++dc) usable_column[dc] = frame_column(dc, corners);
     // The frames: paired_bound.
     V lower = constant<V>(kInf), upper = constant<V>(s_hi);
     ws_.products.resize(sj);
@@ -1056,7 +1065,7 @@ class PairedRoots {
         least = constant<V>(kInf);
         least_den = least;
         for (std::size_t i = 0; i < sj; ++i) {
-          least = vmin(least, (ws_.j[i] + a) / (ws_.products[i] + b));
+          least = vmin(least, (j[i] + a) / (ws_.products[i] + b));
           least_den = vmin(least_den, ws_.products[i] + b);
         }
       }
@@ -1065,8 +1074,7 @@ class PairedRoots {
       for (std::size_t mi = 0; mi < corners; ++mi) {
         const V corner_product =
             down(down(1 * ws_.corner_lo[fr[0] * corners + mi]) * ws_.corner_lo[fr[1] * corners + mi]);
-        upper = paired_corner_upper(ws_.j[static_cast<std::size_t>(j_corners[mi])], err_[0], corner_product, s_hi,
-                                    upper);
+        upper = paired_corner_upper(j[static_cast<std::size_t>(j_corners[mi])], err_[0], corner_product, s_hi, upper);
       }
     }
     const unsigned settled = open & lanes3::mask_bits<4>(up(upper - lower) <= tol);
@@ -1079,7 +1087,7 @@ class PairedRoots {
   // Distinct frame column dc: its dot products with d, shifted, into ws_.along[dc], its
   // bounds into big_, norm_big_, along_err_, ws_.corner_lo; returns the lanes where it is
   // usable.
-  Mask4 column(std::size_t dc, std::size_t corners) {
+  Mask4 frame_column(std::size_t dc, std::size_t corners) {
     const FrameColumn& f = layout_.distinct[dc];
     const auto c0 = static_cast<std::size_t>(f.column[0]);
     const std::size_t n = layout_.size[c0];
@@ -1090,14 +1098,14 @@ class PairedRoots {
     V mag{};
     for (std::size_t x = 0; x < 2; ++x)
       for (std::size_t i = 0; i < n; ++i) {
-        V v = V{} + f.weight[0] * column_lanes(f.column[0], x, i);
+        V v = V{} + f.weight[0] * column(f.column[0], x)[i];
         for (int t = 1; t < f.terms; ++t)
-          v = v + f.weight[static_cast<std::size_t>(t)] * column_lanes(f.column[static_cast<std::size_t>(t)], x, i);
+          v = v + f.weight[static_cast<std::size_t>(t)] * column(f.column[static_cast<std::size_t>(t)], x)[i];
         part[x * n + i] = v;
         mean[x] += v;
         mag = vmax(mag, vabs(v));
       }
-    const V ev = frame_column_error<V>(f, {err_[0], err_[1], err_[2], V{}}, {magnitude_[0], magnitude_[1], V{}});
+    const V ev = frame_column_error<V>(f, {err_[0], err_[1], err_[2], V{}}, {in_.col_magnitude[0], in_.col_magnitude[1], V{}});
     const V spread = norm_spread(ev);
     for (std::size_t mi = 0; mi < corners; ++mi) {
       const auto at = static_cast<std::size_t>(layout_.col_tools[c0]->corners[mi]);
@@ -1142,30 +1150,23 @@ class PairedRoots {
   // 4 i + l).
   static const double* lane_data(const std::vector<V>& v) { return reinterpret_cast<const double*>(v.data()); }
 
-  // Coefficient i of coordinate x of column c, one element per lane.
-  V column_lanes(int c, std::size_t x, std::size_t i) const {
-    V v;
-    for (std::size_t l = 0; l < kW; ++l) v[l] = in_[l].col[static_cast<std::size_t>(c)][x][i];
-    return v;
-  }
+  // Coordinate x of column c.
+  std::span<const V> column(int c, std::size_t x) const { return in_.col[static_cast<std::size_t>(c)][x]; }
 
   const ScaledJacobianSpace& space_;
-  const std::array<QuotientInput, 4>& in_;
+  const QuotientLanes& in_;
   const QuotientLayout& layout_;
   Scratch& ws_;
-  std::array<V, 3> err_{};        // J's, then each column's error bound
-  std::array<V, 2> magnitude_{};  // each column's magnitude
+  std::array<V, 3> err_{};  // J's, then each column's error bound
   std::array<V, kMaxDistinct> big_{}, norm_big_{}, along_err_{};
 };
 
 }  // namespace
 
-unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, double tol,
+unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const QuotientLanes& in, double tol,
                                std::array<QualityBounds, 4>& out) {
   if (!use_paired_stage || space.dim() != 2) return 0;
-  for (const QuotientInput& q : in)
-    if (q.coordinates != 2 || q.j.size() != in[0].j.size()) return 0;
-  if (layout_of(space, in[0]).triple.empty()) return 0;
+  if (layout_of(space, shape_of(in)).triple.empty()) return 0;
   thread_local PairedRoots::Scratch scratch;
   PairedRoots roots(space, in, scratch);
   return roots.run(tol, out);

@@ -49,6 +49,7 @@
 #include <span>
 #include <vector>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "quadval/bezier_basis.hpp"
 #include "quadval/quality_bounds.hpp"
@@ -85,13 +86,25 @@ using FrameBounds = std::array<double, 4>;
 QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
                               int max_splits, int max_paired_splits, FrameBounds* frame_lower = nullptr);
 
-/// quotient_bounds of four planar 2D elements of one space (coordinates = 2) at once, each
-/// in its own SIMD lane, as far as its root: returns bit l where element in[l]'s first stage
-/// meets the tolerance at the root, with out[l] then exactly quotient_bounds(space, in[l],
-/// tol, any, any) (no subdivision); the other lanes' elements need quotient_bounds. Bit l
-/// is also clear wherever the lanes do not apply (other dimensions, a product without
-/// an entry kernel, the tests' switch).
-unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const std::array<QuotientInput, 4>& in, double tol,
+/// J and the columns of four planar 2D elements of one space, element l in lane l of every
+/// vector: what QuotientInput holds of each, with coordinates = 2 (x and y).
+struct QuotientLanes {
+  std::span<const Lanes<4>> j;                                  ///< J's coefficients
+  const std::vector<FactorDegree>* j_degrees = nullptr;
+  Lanes<4> j_error{};                                           ///< |computed - exact| per coefficient
+  std::array<std::array<std::span<const Lanes<4>>, 2>, 2> col;  ///< column c, coordinate x: its coefficients
+  std::array<const std::vector<FactorDegree>*, 2> col_degrees{};
+  std::array<Lanes<4>, 2> col_error{};      ///< per column, both coordinates
+  std::array<Lanes<4>, 2> col_magnitude{};  ///< >= |every computed coefficient|
+};
+
+/// quotient_bounds of four planar 2D elements of one space at once, in SIMD lanes, as far
+/// as their roots: returns bit l where lane l's first stage meets the tolerance at the
+/// root, with out[l] then exactly what quotient_bounds(space, that element's QuotientInput,
+/// tol, any, any) returns (no subdivision); the other lanes' elements need quotient_bounds.
+/// 0 wherever the lanes do not apply (other dimensions, a product without an entry kernel,
+/// the tests' switch).
+unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const QuotientLanes& in, double tol,
                                std::array<QualityBounds, 4>& out);
 
 /// The same on an element where J <= 0 was found at a point (so sj(E) <= 0), in 3D or

@@ -74,6 +74,23 @@ struct SparseRows {
     out[1] = s1;
     out[2] = 0;
   }
+  /// Every row times the x and y of four point sets at once, set l in lane l (d[2 i + a]:
+  /// coordinate a of node i): out[a * rows() + r] = sum_i entry(r, i) d[2 i + a], each lane
+  /// the bits of row_times_flat_points on its set (nonzero entries in node order).
+  void rows_times_planar_lanes(const Lanes<4>* d, Lanes<4>* out) const {
+    const std::size_t n = rows();
+    for (std::size_t r = 0; r < n; ++r) {
+      Lanes<4> s0{}, s1{};
+      for (std::uint32_t t = start[r]; t < start[r + 1]; ++t) {
+        const double g = value[t];
+        const Lanes<4>* p = d + 2 * static_cast<std::size_t>(node[t]);
+        s0 += g * p[0];
+        s1 += g * p[1];
+      }
+      out[r] = s0;
+      out[n + r] = s1;
+    }
+  }
   /// Rows 4 b .. 4 b + 3 at once (lane l: row 4 b + l; lanes past the last row give +0)
   /// times the first NX coordinates of d: out[a] = sum_i entry(row, i) d[3 i + a] over every
   /// node in order, zeros included. For finite d the same bits as row_times_points: a zero

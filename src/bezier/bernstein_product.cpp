@@ -632,6 +632,32 @@ bool BernsteinProduct::multiply4(const double* f, const double* g, double* h) co
   return true;
 }
 
+bool BernsteinProduct::multiply_add_sum2x4(double s0, const double* f0, const double* g0, double s1,
+                                           const double* f1, const double* g1, double* h) const {
+  if (!entries_kernel_ || pairs_.empty()) return false;
+  typedef double V4 __attribute__((vector_size(32)));
+  const auto lanes = [](const double* p) {
+    V4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  };
+  // fused_entries<2>'s rows, lane by lane.
+  const Pair* pairs = pairs_.data();
+  for (int k = 0; k < h_size_; ++k) {
+    V4 acc{};
+    for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
+      const std::size_t i = 4 * static_cast<std::size_t>(pairs[p].i), j = 4 * static_cast<std::size_t>(pairs[p].j);
+      V4 sum{};
+      sum += s0 * (lanes(f0 + i) * lanes(g0 + j));
+      sum += s1 * (lanes(f1 + i) * lanes(g1 + j));
+      acc += pairs[p].w * sum;
+    }
+    const V4 out = lanes(h + 4 * static_cast<std::size_t>(k)) + acc;
+    std::memcpy(h + 4 * static_cast<std::size_t>(k), &out, sizeof out);
+  }
+  return true;
+}
+
 double BernsteinProduct::rounding(int products) const noexcept {
   // Entry kernel, per term: weight (2u allowed; nearest_double is within u), two weight
   // products, scale, f*g and the term product: 8 roundings; scaled form: 12 (see the top

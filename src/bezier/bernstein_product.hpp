@@ -52,6 +52,12 @@ class BernsteinProduct {
   /// arithmetic of multiply: the same bits, in one walk over the pairs for all four.
   /// Returns false, computing nothing, without an entry kernel (large products).
   bool multiply4(const double* f, const double* g, double* h) const;
+  /// h += s0 f0 g0 + s1 f1 g1 on four lanes at once (interleaved as multiply4), each lane
+  /// with exactly the arithmetic of multiply_add_sum on those two terms (f0 != g0 or f1 !=
+  /// g1: not squares): the same bits. Returns false, computing nothing, where that is not
+  /// the entry kernel's two-term walk (large products).
+  bool multiply_add_sum2x4(double s0, const double* f0, const double* g0, double s1, const double* f1,
+                           const double* g1, double* h) const;
   /// One term scale * f * g of a sum of products in the same spaces.
   struct Term {
     double scale;

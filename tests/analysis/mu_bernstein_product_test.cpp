@@ -339,6 +339,50 @@ TEST(MuBernsteinProduct, Multiply4EqualsFourMultipliesBitForBit) {
   }
 }
 
+// multiply_add_sum2x4 (two terms on four lanes, the planar scaled Jacobian's J = c_0,x
+// c_1,y - c_0,y c_1,x) against multiply_add_sum on each lane alone: the same bits, signed
+// zeros included, added to what h held; declined, h untouched, without the entry kernel.
+TEST(MuBernsteinProduct, TwoTermSumsInLanesEqualEachLaneBitForBit) {
+  const std::vector<std::pair<std::vector<FactorDegree>, std::vector<FactorDegree>>> cases{
+      {{{2, 1}}, {{2, 1}}}, {{{2, 3}}, {{2, 3}}}, {{{2, 5}}, {{2, 5}}},
+      {{{1, 1}, {1, 2}}, {{1, 2}, {1, 1}}}, {{{1, 3}, {1, 4}}, {{1, 4}, {1, 3}}}};
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto value = [&] { return rng() % 7 == 0 ? (rng() % 2 ? 0.0 : -0.0) : u(rng) * std::ldexp(1.0, static_cast<int>(8 * u(rng))); };
+  for (const auto& [fd, gd] : cases) {
+    SCOPED_TRACE(::testing::Message() << "f space of " << fd.size() << " factors, degree " << fd[0].degree);
+    const BernsteinProduct& table = bernstein_product(fd, gd);
+    const auto nf = static_cast<std::size_t>(table.f_size()), ng = static_cast<std::size_t>(table.g_size()),
+               nh = static_cast<std::size_t>(table.h_size());
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<double> f0(4 * nf), g0(4 * ng), f1(4 * nf), g1(4 * ng), h(4 * nh);
+      for (auto* v : {&f0, &g0, &f1, &g1, &h})
+        for (double& x : *v) x = value();
+      const std::vector<double> h_before = h;
+      ASSERT_TRUE(table.multiply_add_sum2x4(1.0, f0.data(), g0.data(), -1.0, f1.data(), g1.data(), h.data()));
+      for (std::size_t l = 0; l < 4; ++l) {
+        const auto lane = [&](const std::vector<double>& v, std::size_t n) {
+          std::vector<double> out(n);
+          for (std::size_t i = 0; i < n; ++i) out[i] = v[4 * i + l];
+          return out;
+        };
+        const std::vector<double> a = lane(f0, nf), b = lane(g0, ng), c = lane(f1, nf), d = lane(g1, ng);
+        std::vector<double> want = lane(h_before, nh);
+        const BernsteinProduct::Term terms[2] = {{1.0, a.data(), b.data()}, {-1.0, c.data(), d.data()}};
+        table.multiply_add_sum(terms, want.data());
+        for (std::size_t k = 0; k < nh; ++k)
+          ASSERT_EQ(std::bit_cast<std::uint64_t>(h[4 * k + l]), std::bit_cast<std::uint64_t>(want[k]))
+              << "lane " << l << " k " << k << ": " << h[4 * k + l] << " vs " << want[k];
+      }
+    }
+  }
+  const BernsteinProduct& large = bernstein_product(std::vector<FactorDegree>{{1, 4}, {1, 4}, {1, 4}},
+                                                    std::vector<FactorDegree>{{1, 4}, {1, 4}, {1, 4}});
+  std::vector<double> f(4 * static_cast<std::size_t>(large.f_size()), 1.0), h(4 * static_cast<std::size_t>(large.h_size()), -7.0);
+  EXPECT_FALSE(large.multiply_add_sum2x4(1.0, f.data(), f.data(), -1.0, f.data(), f.data(), h.data()));
+  EXPECT_TRUE(std::all_of(h.begin(), h.end(), [](double v) { return v == -7.0; }));
+}
+
 // A large product (a quadratic pyramid's second frame product: 125 x 27 pairs) has no entry
 // kernel: multiply4 says so and leaves h alone, and the caller multiplies one lane at a time.
 TEST(MuBernsteinProduct, Multiply4DeclinesLargeProducts) {

@@ -742,6 +742,28 @@ TEST(ScaledJacobian, FourPlanarElementsInLanesGiveTheirOwnBounds) {
   EXPECT_GT(answered, elements * 3 / 4);
 }
 
+// An element off its plane z = const among four (a planar mesh's element tilted in z):
+// the lanes do not answer for its curved neighbours, which then take their own calls;
+// whatever they do answer is still the elements' own bounds.
+TEST(ScaledJacobian, FourPlanarElementsWithOneOffThePlaneAnswerNothingWrong) {
+  std::mt19937 rng(77);
+  QualityOptions o;
+  o.abs_tol = 1e-2;
+  const ElementType& t = *find_element_type(ElementFamily::triangle, 3, true);
+  BoundsWorkspace bw;
+  std::vector<std::vector<double>> xs;
+  while (xs.size() < 4) {
+    std::vector<double> x = test::smooth_random_element(t, 0.02, rng);
+    if (jacobian_bounds(t, x, {}, bw, true).validity == Validity::valid) xs.push_back(std::move(x));
+  }
+  std::array<std::span<const double>, 4> x{xs[0], xs[1], xs[2], xs[3]};
+  std::array<QualityBounds, 4> out;
+  EXPECT_EQ(scaled_jacobian_valid_planar4(t, x, o, {}, out), 15u);  // all curved, all in z = 0
+  xs[2][3 * 5 + 2] = 1e-3;  // node 5 off the plane
+  x[2] = xs[2];
+  EXPECT_EQ(scaled_jacobian_valid_planar4(t, x, o, {}, out), 0u);
+}
+
 // The signed first stage (J's coefficients with their signs, over products of the columns
 // along their mean directions) on inverted curved 3D elements up to order 3: its lower
 // bound never above the sampled minimum (an oracle sharing no code with it), its upper

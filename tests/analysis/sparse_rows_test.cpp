@@ -71,6 +71,25 @@ void check_map(const std::vector<double>& map, std::size_t rows, std::size_t n, 
         for (std::size_t a = 0; a < 3; ++a) expect_same_bits(all[a * rows + r], want[a], "times_points");
       }
     }
+    // Four flat point sets in lanes (this one in lane trial, others scaled): each lane the
+    // bits of its own rows.
+    if (flat) {
+      std::vector<Lanes<4>> dl(2 * n), out(2 * rows);
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t a = 0; a < 2; ++a)
+          for (std::size_t l = 0; l < 4; ++l) dl[2 * i + a][l] = l == 1 ? d[3 * i + a] : (1.0 + 0.1 * l) * d[3 * i + a];
+      sparse.rows_times_planar_lanes(dl.data(), out.data());
+      for (std::size_t l = 0; l < 4; ++l) {
+        std::vector<double> dd(3 * n);
+        for (std::size_t i = 0; i < n; ++i)
+          for (std::size_t a = 0; a < 2; ++a) dd[3 * i + a] = dl[2 * i + a][l];
+        for (std::size_t r = 0; r < rows; ++r) {
+          double want[3];
+          dense_row(map, r, n, dd.data(), want);
+          for (std::size_t a = 0; a < 2; ++a) expect_same_bits(out[a * rows + r][l], want[a], "rows_times_planar_lanes");
+        }
+      }
+    }
     // Lanes past the last row are +0.
     if (rows % 4 != 0) {
       Lanes<4> lanes[3] = {};
