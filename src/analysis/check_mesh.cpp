@@ -386,9 +386,9 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     std::vector<std::size_t> rest;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
-    std::vector<QualityBounds> lane_mu, lane_sj;
+    std::vector<QualityBounds> lane_mu, lane_sj, lane_planar_mu;
     std::vector<double> validity_ticks;
-    std::vector<char> lane_sj_done;
+    std::vector<char> lane_sj_done, lane_mu_planar_done;
     unsigned lane_mu_done[kLinearChunk / kNativeLanes];
     const Buffer own = batched ? Buffer{} : make_buffer(kFastChunk);  // the largest chunk
     for (;;) {
@@ -455,6 +455,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (want_mu && mu_given) {
                 mu[index] = *mu_given;
                 ++st.mu.computed;
+                if (!mu_given->tolerance_met) ++st.mu.tolerance_not_met;
               } else if (want_mu)
                 quality(mu_supported(type), mu[index], st.mu, xe, known,
                         [v](const ElementType& t, std::span<const double> x, const QualityOptions& q, bool planar,
@@ -471,13 +472,14 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // What every analysed element gets once its bounds are known.
             // known: the element's straight-sided margin when its chunk computed it.
             const auto finish = [&](std::size_t index, const double* xe, double ticks,
-                                    const KnownMargin* known = nullptr, const QualityBounds* sj_given = nullptr) {
+                                    const KnownMargin* known = nullptr, const QualityBounds* mu_given = nullptr,
+                                    const QualityBounds* sj_given = nullptr) {
               ElementCheck& ec = elements[index];
               ec.analysed = true;
               const JacobianBounds& b = ec.bounds;
               if (want_distortion)
                 distortion[index] = distortion_from(jacobian_space(type), xe, report.planar, b, ws, bo);
-              qualities(index, xe, b.validity, known, nullptr, sj_given);
+              qualities(index, xe, b.validity, known, mu_given, sj_given);
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
@@ -644,12 +646,15 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               } else {
                 for (std::size_t i = 0; i < ch.count; ++i) rest[left++] = i;
               }
-              // The scaled Jacobian of the valid elements of `rest` (their nodes in `nodes`,
-              // their validity known), four at a time: lane_sj_done[k] where lane_sj[k] holds
-              // element k's, else it needs the element's own call.
-              const auto planar_sj_lanes = [&] {
+              // mu and the scaled Jacobian of the valid elements of `rest` (their nodes in
+              // `nodes`, their validity known), four at a time: lane_sj_done[k] where
+              // lane_sj[k] holds element k's, likewise lane_mu_planar_done and lane_planar_mu;
+              // else it needs the element's own call.
+              const auto planar_lanes = [&] {
                 lane_sj_done.assign(left, 0);
                 lane_sj.resize(left);
+                lane_mu_planar_done.assign(left, 0);
+                lane_planar_mu.resize(left);
                 for (std::size_t k = 0; k < left;) {
                   std::array<std::size_t, 4> group{};
                   std::size_t count = 0;
@@ -668,12 +673,22 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                     }
                   }
                   std::array<QualityBounds, 4> out;
-                  const unsigned done = scaled_jacobian_valid_planar4(type, x, qo, known, out);
-                  for (std::size_t l = 0; l < count; ++l)
-                    if ((done >> l) & 1u) {
-                      lane_sj[group[l]] = out[l];
-                      lane_sj_done[group[l]] = 1;
-                    }
+                  if (want_sj && scaled_jacobian_supported(type)) {
+                    const unsigned done = scaled_jacobian_valid_planar4(type, x, qo, known, out);
+                    for (std::size_t l = 0; l < count; ++l)
+                      if ((done >> l) & 1u) {
+                        lane_sj[group[l]] = out[l];
+                        lane_sj_done[group[l]] = 1;
+                      }
+                  }
+                  if (want_mu && mu_supported(type)) {
+                    const unsigned done = mu_valid_planar4(type, x, qo, known, out);
+                    for (std::size_t l = 0; l < count; ++l)
+                      if ((done >> l) & 1u) {
+                        lane_planar_mu[group[l]] = out[l];
+                        lane_mu_planar_done[group[l]] = 1;
+                      }
+                  }
                 }
               };
               nodes.resize(left * nn * 3);
@@ -705,11 +720,11 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // counts in the next element's stage); mu, the scaled Jacobian and distortion
               // in `finish` are kept out of the stage times.
               const bool light_finish = !want_mu && !want_sj && !want_distortion;
-              // The scaled Jacobian of valid planar 2D elements four at a time
-              // (scaled_jacobian_valid_planar4: the same bounds), once the validity of all
-              // of them is known.
-              const bool planar_lanes = want_sj && report.planar && type.dim == 2 && scaled_jacobian_supported(type);
-              if (planar_lanes) {
+              // mu and the scaled Jacobian of valid planar 2D elements four at a time
+              // (mu_valid_planar4, scaled_jacobian_valid_planar4: the same bounds), once the
+              // validity of all of them is known.
+              const bool in_lanes = (want_sj || want_mu) && report.planar && type.dim == 2;
+              if (in_lanes) {
                 validity_ticks.resize(left);
                 for (std::size_t k = 0; k < left; ++k) {
                   elements[ch.out + rest[k]].bounds = bounds_from_coefficients(
@@ -718,16 +733,16 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   validity_ticks[k] = batch_share + static_cast<double>(done_at - te);
                   te = done_at;
                 }
-                planar_sj_lanes();
+                planar_lanes();
               }
               for (std::size_t k = 0; k < left; ++k) {
                 const std::size_t i = rest[k];
                 ElementCheck& ec = elements[ch.out + i];
                 const double* xe = nodes.data() + k * nn * 3;
                 const KnownMargin known = margins_known ? known_margin(i) : KnownMargin{};
-                if (planar_lanes) {
-                  const QualityBounds* given = lane_sj_done[k] ? &lane_sj[k] : nullptr;
-                  finish(ch.out + i, xe, validity_ticks[k], margins_known ? &known : nullptr, given);
+                if (in_lanes) {
+                  finish(ch.out + i, xe, validity_ticks[k], margins_known ? &known : nullptr,
+                         lane_mu_planar_done[k] ? &lane_planar_mu[k] : nullptr, lane_sj_done[k] ? &lane_sj[k] : nullptr);
                   continue;
                 }
                 ec.bounds = bounds_from_coefficients(space, coeffs.data() + k * s, errors[k], xe,

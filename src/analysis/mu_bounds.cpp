@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <span>
 #include <functional>
 #include <vector>
 
@@ -24,8 +25,10 @@
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/straight_tet_mu.hpp"
+#include "analysis/symmetric3_lanes.hpp"
 #include "analysis/trilinear_hex_mu.hpp"
 #include "bezier/bernstein_bisection.hpp"
+#include "bezier/bernstein_product.hpp"
 #include "quadval/error.hpp"
 #include "quadval/jacobian_bounds.hpp"
 
@@ -448,6 +451,164 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
     }
   }
   return out;
+}
+
+namespace {
+
+// mu_bounds_given's steps from element_w to its root's tolerance test, for four valid
+// planar elements in planes z = const whose closed forms did not apply, element l in lane
+// l of every vector: the same operations lane by lane (SparseRows::rows_times_planar_lanes,
+// BernsteinProduct::gram_sums2x4, the enclosures of mu_control_bound.hpp), so the same
+// bits. W's z coordinates are +0 there (not stored). Returns bit l where lane l's root meets
+// the tolerance and the scalar path takes the same branches (W not constant, every
+// corner's closed form at least 1e-2), out[l] then exactly mu_bounds_given's result.
+unsigned planar_mu_roots(const MuSpace& space, const std::array<std::span<const double>, 4>& nodes, double tol,
+                         std::array<QualityBounds, 4>& out) {
+  using V = Lanes<4>;
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  const auto up = [](V x) { return lanes3::up<4>(x); };
+  const int n = space.num_nodes();
+  const auto nn = static_cast<std::size_t>(n);
+  const auto ws = static_cast<std::size_t>(space.w_size());
+  const auto& jinv = space.ideal_inverse();
+  thread_local std::vector<V> d, xc, w, m;
+  // element_w: x_i - x_0, their range, X_c's control values, W_j = sum_c Jinv_cj X_c.
+  d.resize(2 * nn);
+  V range{};
+  for (std::size_t l = 0; l < 4; ++l) {
+    const double* x = nodes[l].data();
+    double r = 0;
+    for (std::size_t i = 0; i < nn; ++i) {
+      for (std::size_t c = 0; c < 3; ++c) r = std::max(r, std::abs(x[3 * i + c] - x[c]));
+      if (x[3 * i + 2] - x[2] != 0) return 0;
+      d[2 * i][l] = x[3 * i] - x[0];
+      d[2 * i + 1][l] = x[3 * i + 1] - x[1];
+    }
+    if (!(r < kInf)) return 0;
+    range[l] = r;
+  }
+  xc.resize(4 * ws);  // (c, a) at (2 c + a) ws
+  for (int c = 0; c < 2; ++c) space.derivative_nonzeros(c).rows_times_planar_lanes(d.data(), xc.data() + 2 * c * ws);
+  w.resize(4 * ws);  // (j, a) at (2 j + a) ws
+  for (std::size_t j = 0; j < 2; ++j)
+    for (std::size_t a = 0; a < 2; ++a)
+      for (std::size_t k = 0; k < ws; ++k)
+        w[(2 * j + a) * ws + k] = (V{} + jinv[j] * xc[a * ws + k]) + jinv[3 + j] * xc[(2 + a) * ws + k];
+  double worst = 0;
+  for (int j = 0; j < 2; ++j) {
+    double s = 0;
+    for (int c = 0; c < 2; ++c) s += std::abs(jinv[static_cast<std::size_t>(c * 3 + j)]) * space.derivative_row_sum(c);
+    worst = std::max(worst, s);
+  }
+  const V err0 = rounding_gamma(n + 2 + 9) * worst * range * (1 + 1e-12);
+  // Constant W (constant_w_radius): that lane takes mu_constant.hpp's closed form instead.
+  V wmax{}, dev{};
+  for (std::size_t r = 0; r < 4; ++r) {
+    const V* p = w.data() + r * ws;
+    for (std::size_t k = 0; k < ws; ++k) wmax = vmax(wmax, vabs(p[k]));
+    for (std::size_t k = 1; k < ws; ++k) dev = vmax(dev, vabs(p[k] - p[0]));
+  }
+  const V stop = 1e-9 * wmax;
+  unsigned open = 15u & ~lanes3::mask_bits<4>((dev <= stop) & (up(err0 + up(dev)) <= stop));
+  // corner_ratio_upper: the least closed-form bound over the corners (its skipped corners
+  // are certified at least its bound, so the least is the same); a lane where one is below
+  // 1e-2 would take Rayleigh quotients too.
+  V r_upper = V{} + 1;
+  for (const int k : space.w_basis().vertex_indices()) {
+    const auto at = static_cast<std::size_t>(k);
+    static constexpr int kPairs2[3][2] = {{0, 0}, {1, 1}, {0, 1}};
+    V cm[3], cerr{};
+    for (std::size_t e = 0; e < 3; ++e) {
+      V sum{}, mag{}, prop{};
+      for (std::size_t c = 0; c < 3; ++c) {
+        const auto i = static_cast<std::size_t>(kPairs2[e][0]), j = static_cast<std::size_t>(kPairs2[e][1]);
+        const V a = c < 2 ? w[(2 * i + c) * ws + at] : V{}, b = c < 2 ? w[(2 * j + c) * ws + at] : V{};
+        sum += a * b;
+        mag += vabs(a * b);
+        prop += (vabs(a) + vabs(b) + err0) * err0;
+      }
+      cm[e] = sum;
+      cerr = vmax(cerr, (prop + rounding_gamma(4) * mag) * (1 + 1e-12));
+    }
+    const V closed = enclosure_ratio_upper2_lanes(cm, cerr);
+    open &= ~lanes3::mask_bits<4>(closed < 1e-2);
+    r_upper = vmin(r_upper, closed);
+  }
+  if (open == 0) return 0;
+  // MuMetric::metric: M's control values by gram_sums, its error bound.
+  const BernsteinProduct& p11 = space.prod(1, 1);
+  const auto size = static_cast<std::size_t>(space.size(2));
+  m.assign(3 * size, V{});
+  const double* columns[4];
+  V mag[6];
+  for (std::size_t j = 0; j < 2; ++j)
+    for (std::size_t x = 0; x < 3; ++x) {
+      mag[3 * j + x] = V{};
+      if (x == 2) continue;
+      const V* p = w.data() + (2 * j + x) * ws;
+      columns[2 * j + x] = reinterpret_cast<const double*>(p);
+      for (std::size_t k = 0; k < ws; ++k) mag[3 * j + x] = vmax(mag[3 * j + x], vabs(p[k]));
+    }
+  double* h[3] = {reinterpret_cast<double*>(m.data()), reinterpret_cast<double*>(m.data() + size),
+                  reinterpret_cast<double*>(m.data() + 2 * size)};
+  if (!p11.gram_sums2x4(columns, h)) return 0;
+  V m_err{};
+  for (const auto& [a, b] : BernsteinProduct::kGramEntries2) {
+    V prop{}, scale_fg{};
+    for (std::size_t x = 0; x < 3; ++x) {
+      const V fm = mag[3 * static_cast<std::size_t>(a) + x], gm = mag[3 * static_cast<std::size_t>(b) + x];
+      prop += fm * err0 + err0 * gm + err0 * err0;
+      scale_fg += fm * gm;
+    }
+    m_err = vmax(m_err, (prop + p11.rounding(3) * scale_fg) * (1 + 1e-12));
+  }
+  // control_ratio_lower<2>: the least enclosure over M's control matrices.
+  const V e = vmax(vmax(vmax(V{}, m_err), m_err), m_err);
+  V control = V{} + 1;
+  for (std::size_t k = 0; k < size; ++k) {
+    const V mk[3] = {m[k], m[size + k], m[2 * size + k]};
+    control = vmin(control, enclosure_ratio_lower2_lanes<4>(mk, e));
+  }
+  const V lo = vmax(V{}, control);
+  unsigned settled = 0;
+  for (std::size_t l = 0; l < 4; ++l) {
+    if (!((open >> l) & 1u)) continue;
+    const double lower = sqrt_down(lo[l]), upper = sqrt_up(r_upper[l]);
+    if (!(upper - lower <= tol)) continue;
+    out[l] = {lower, upper, 0, true};
+    settled |= 1u << l;
+  }
+  return settled;
+}
+
+}  // namespace
+
+unsigned mu_valid_planar4(const ElementType& type, const std::array<std::span<const double>, 4>& nodes,
+                          const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
+                          std::array<QualityBounds, 4>& out) {
+  QV_ASSERT(mu_supported(type) && type.dim == 2, "four planar elements of " << type.name);
+  if (!mu_constant_path_enabled()) return 0;
+  const MuSpace& space = mu_space(type);
+  if (space.has_certificate() && control_mode == 0) return 0;
+  thread_local std::vector<double> pool;
+  pool.resize(static_cast<std::size_t>(space.dim() * 3 * space.w_size()));
+  unsigned done = 0;
+  for (std::size_t l = 0; l < 4; ++l) {
+    // mu_bounds_given's closed forms first, as it takes them.
+    if (const auto straight = straight_simplex_mu(space, nodes[l], pool.data(), options.abs_tol, known[l])) {
+      out[l] = *straight;
+      done |= 1u << l;
+    } else if (const auto bilinear = bilinear_quad_mu_bounds(type, nodes[l], options.abs_tol, known[l])) {
+      out[l] = *bilinear;
+      done |= 1u << l;
+    }
+  }
+  if (done == 15) return done;
+  std::array<QualityBounds, 4> roots;
+  const unsigned settled = planar_mu_roots(space, nodes, options.abs_tol, roots) & ~done;
+  for (std::size_t l = 0; l < 4; ++l)
+    if ((settled >> l) & 1u) out[l] = roots[l];
+  return done | settled;
 }
 
 }  // namespace quadval

@@ -168,30 +168,60 @@ unsigned ratio_at_least3_lanes(const LW* m, double err, double r) {
   return lanes3::mask_bits<kW>(lanes3::ratio_at_least<kW>(m, err, r));
 }
 
-// symmetric_eigen_enclosure<2>(m, err).ratio_lower() of kW matrices at once (lane l:
-// entries m[i][l]), each lane with the scalar functions' operations in the same order
-// (bit-identical per matrix).
-LW enclosure_ratio_lower2_lanes(const LW* m, double err) {
-  const LW zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
-  const LW rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
-  const LW s_hi = up<kW>(vabs(s) + rq), s_lo = vmax(zero, down<kW>(vabs(s) - rq));
-  const LW t_hi = up<kW>(vabs(t) + err), t_lo = vmax(zero, down<kW>(vabs(t) - err));
-  LW d_hi = up<kW>(up<kW>(s_hi * s_hi) + up<kW>(t_hi * t_hi));
-  LW d_lo = vmax(zero, down<kW>(down<kW>(s_lo * s_lo) + down<kW>(t_lo * t_lo)));
-  for (int l = 0; l < kW; ++l) {  // vsqrtpd: exact rounding, as std::sqrt
+}  // namespace
+
+template <int W>
+Lanes<W> enclosure_ratio_lower2_lanes(const Lanes<W>* m, Lanes<W> err) {
+  using lanes3::down;
+  using lanes3::up;
+  using V = Lanes<W>;
+  const V zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
+  const V rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
+  const V s_hi = up<W>(vabs(s) + rq), s_lo = vmax(zero, down<W>(vabs(s) - rq));
+  const V t_hi = up<W>(vabs(t) + err), t_lo = vmax(zero, down<W>(vabs(t) - err));
+  V d_hi = up<W>(up<W>(s_hi * s_hi) + up<W>(t_hi * t_hi));
+  V d_lo = vmax(zero, down<W>(down<W>(s_lo * s_lo) + down<W>(t_lo * t_lo)));
+  for (int l = 0; l < W; ++l) {  // vsqrtpd: exact rounding, as std::sqrt
     d_hi[l] = std::sqrt(d_hi[l]);
     d_lo[l] = std::sqrt(d_lo[l]);
   }
-  d_hi = up<kW>(d_hi);
-  d_lo = vmax(zero, down<kW>(d_lo));
-  const LW q_lo = down<kW>(q - rq), q_hi = up<kW>(q + rq);
-  const LW min_lo = down<kW>(q_lo - d_hi), max_hi = up<kW>(q_hi + d_hi);
+  d_hi = up<W>(d_hi);
+  d_lo = vmax(zero, down<W>(d_lo));
+  const V q_lo = down<W>(q - rq), q_hi = up<W>(q + rq);
+  const V min_lo = down<W>(q_lo - d_hi), max_hi = up<W>(q_hi + d_hi);
   constexpr double kMax = std::numeric_limits<double>::max();
   // An enclosure that is unknown (a non-finite step) or not positive: ratio 0.
   const auto known = (vabs(q_lo) <= kMax) & (vabs(q_hi) <= kMax) & (vabs(d_hi) <= kMax) & (min_lo > 0) & (max_hi < kInf);
-  const LW ratio = down<kW>(min_lo / max_hi);
-  return known ? vmin(vmax(ratio, zero), LW{} + 1) : zero;
+  const V ratio = down<W>(min_lo / max_hi);
+  return known ? vmin(vmax(ratio, zero), V{} + 1) : zero;
 }
+template Lanes<4> enclosure_ratio_lower2_lanes<4>(const Lanes<4>*, Lanes<4>);
+
+Lanes<4> enclosure_ratio_upper2_lanes(const Lanes<4>* m, Lanes<4> err) {
+  using lanes3::down;
+  using lanes3::up;
+  using V = Lanes<4>;
+  const V zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
+  const V rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
+  const V s_hi = up<4>(vabs(s) + rq), s_lo = vmax(zero, down<4>(vabs(s) - rq));
+  const V t_hi = up<4>(vabs(t) + err), t_lo = vmax(zero, down<4>(vabs(t) - err));
+  const V d_hi = up<4>(lanes3::root<4>(up<4>(up<4>(s_hi * s_hi) + up<4>(t_hi * t_hi))));
+  const V d_lo = vmax(zero, down<4>(lanes3::root<4>(vmax(zero, down<4>(down<4>(s_lo * s_lo) + down<4>(t_lo * t_lo))))));
+  const V q_lo = down<4>(q - rq), q_hi = up<4>(q + rq);
+  constexpr double kMax = std::numeric_limits<double>::max();
+  const auto known = (vabs(q_lo) <= kMax) & (vabs(q_hi) <= kMax) & (vabs(d_hi) <= kMax);
+  const V min_hi = up<4>(q_hi - d_lo), max_lo = down<4>(q_lo + d_lo);
+  // ratio_upper: 1 where unknown, max_lo not positive or min_hi not finite, else clamped.
+  const V ratio = vmin(vmax(up<4>(min_hi / max_lo), zero), V{} + 1);
+  return known & (max_lo > 0) & (min_hi < kInf) ? ratio : V{} + 1;
+}
+
+namespace {
+
+// symmetric_eigen_enclosure<2>(m, err).ratio_lower() of kW matrices at once (lane l:
+// entries m[i][l]), each lane with the scalar functions' operations in the same order
+// (bit-identical per matrix).
+LW enclosure_ratio_lower2_block(const LW* m, double err) { return quadval::enclosure_ratio_lower2_lanes<kW>(m, LW{} + err); }
 
 // cos(acos(c) / 3) for c in [-1, 1], without trigonometric calls (acos and sincos were a
 // fifth of mu's time on linear hexahedra): the largest root x in [1/2, 1] of
@@ -301,7 +331,7 @@ double control_ratio_lower2(const double* const* entries, double e, int size) {
       for (int l = 0; l < kW; ++l) tail[l] = entries[i][k + l < size ? k + l : 0];
       lanes[i] = load_lanes<kW>(tail);
     }
-    r = fold_min(enclosure_ratio_lower2_lanes(lanes, e), r);
+    r = fold_min(enclosure_ratio_lower2_block(lanes, e), r);
   }
   return r;
 }

@@ -35,6 +35,8 @@
 //     below; Ostrowski's theorem (Horn & Johnson Thm 4.5.9) transfers them to M with
 //     theta in [1 - eps, 1 + eps], eps >= |V^T V - I|_2. Every rounding is covered.
 
+#include "analysis/lane_vector.hpp"
+
 namespace quadval {
 
 /// Tests and benchmarks: how mu_bounds bounds a subdomain in the calling thread:
@@ -107,5 +109,14 @@ double ratio_estimate3(const double* m);
 ///                 least this are not enclosed (2D encloses every matrix anyway)
 template <int D>
 double control_ratio_lower(const double* const* entries, const double* err, int size, double enough = 1);
+
+/// symmetric_eigen_enclosure<2>(m_l, err_l).ratio_lower() of W matrices at once, matrix l
+/// in lane l (entries m[i][l]): the scalar function's operations lane by lane, the same bits.
+template <int W>
+Lanes<W> enclosure_ratio_lower2_lanes(const Lanes<W>* m, Lanes<W> err);
+
+/// symmetric_eigen_enclosure<2>(m_l, err_l).ratio_upper() of four matrices at once, matrix
+/// l in lane l: the same bits lane by lane.
+Lanes<4> enclosure_ratio_upper2_lanes(const Lanes<4>* m, Lanes<4> err);
 
 }  // namespace quadval

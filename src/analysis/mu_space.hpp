@@ -7,6 +7,7 @@
 #include <array>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <vector>
 
 #include "analysis/jacobian_product.hpp"
@@ -157,5 +158,15 @@ const MuSpace& mu_space(const ElementType& type);
 QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> nodes,
                               const QualityOptions& options, bool planar, Validity validity,
                               const KnownMargin* known = nullptr);
+
+/// mu_bounds_given(type, nodes[l], options, true, Validity::valid, known[l]) for four valid
+/// planar 2D elements at once, where it is settled without subdivisions (closed forms, or
+/// its root in SIMD lanes where the elements lie in planes z = const): bit l set where
+/// out[l] holds exactly that call's result; the others need the call. A lane's result does
+/// not depend on the other lanes (pass an element twice to fill them). @pre type.dim == 2,
+/// mu_supported(type), every element valid
+unsigned mu_valid_planar4(const ElementType& type, const std::array<std::span<const double>, 4>& nodes,
+                          const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
+                          std::array<QualityBounds, 4>& out);
 
 }  // namespace quadval

@@ -552,6 +552,34 @@ bool BernsteinProduct::gram_sums(const double* const* w, int columns, double* co
   return true;
 }
 
+bool BernsteinProduct::gram_sums2x4(const double* const* w, double* const* h) const {
+  if (!entries_kernel_ || pairs_.empty()) return false;
+  typedef double V4 __attribute__((vector_size(32)));
+  const auto at = [](const double* p, int i) {
+    V4 v;
+    std::memcpy(&v, p + 4 * static_cast<std::size_t>(i), sizeof v);
+    return v;
+  };
+  // gram_entries<2, 2>'s rows, lane by lane: per entry (a, b), sum_x a_x(i) b_x(j).
+  const Pair* pairs = pairs_.data();
+  for (int k = 0; k < h_size_; ++k) {
+    V4 acc[3] = {};
+    for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
+      const int i = pairs[p].i, j = pairs[p].j;
+      for (std::size_t e = 0; e < 3; ++e) {
+        const auto [a, b] = kGramEntries2[e];
+        const V4 dot = at(w[2 * a], i) * at(w[2 * b], j) + at(w[2 * a + 1], i) * at(w[2 * b + 1], j);
+        acc[e] += pairs[p].w * dot;
+      }
+    }
+    for (std::size_t e = 0; e < 3; ++e) {
+      const V4 out = at(h[e], k) + acc[e];
+      std::memcpy(h[e] + 4 * static_cast<std::size_t>(k), &out, sizeof out);
+    }
+  }
+  return true;
+}
+
 void BernsteinProduct::multiply_add_sum(std::span<const Term> terms, double* h) const {
   if (entries_kernel_) {
     const bool squares = !square_pairs_.empty() &&

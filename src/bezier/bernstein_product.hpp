@@ -80,6 +80,11 @@ class BernsteinProduct {
   /// zero everywhere (a planar element's z), as its products, +-0, change a pair's sum at
   /// most in the sign of a zero, which the row's sum from +0 then drops.
   bool gram_sums(const double* const* w, int columns, double* const* h, int coordinates = 3) const;
+  /// gram_sums of two columns of two coordinates (planar elements) on four lanes at once
+  /// (interleaved as multiply4): w[2 a + x] holds coordinate x of column a, h[e] receives
+  /// entry e of kGramEntries2, each lane with exactly gram_sums' arithmetic: the same bits.
+  /// Returns false, adding nothing, without an entry kernel.
+  bool gram_sums2x4(const double* const* w, double* const* h) const;
   /// gram_sums' entries (a, b), in order: 3 columns, then 2.
   static constexpr std::array<std::array<int, 2>, 6> kGramEntries3{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
   static constexpr std::array<std::array<int, 2>, 3> kGramEntries2{{{0, 0}, {1, 1}, {0, 1}}};

@@ -383,6 +383,39 @@ TEST(MuBernsteinProduct, TwoTermSumsInLanesEqualEachLaneBitForBit) {
   EXPECT_TRUE(std::all_of(h.begin(), h.end(), [](double v) { return v == -7.0; }));
 }
 
+// gram_sums2x4 (the Gram sums of two planar columns on four lanes) against gram_sums on each
+// lane alone (two coordinates): the same bits, signed zeros included.
+TEST(MuBernsteinProduct, PlanarGramSumsInLanesEqualEachLaneBitForBit) {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (const std::vector<FactorDegree>& deg : {std::vector<FactorDegree>{{2, 2}}, std::vector<FactorDegree>{{2, 4}},
+                                              std::vector<FactorDegree>{{1, 2}, {1, 2}}}) {
+    const BernsteinProduct& table = bernstein_product(deg, deg);
+    const auto n = static_cast<std::size_t>(table.f_size()), nh = static_cast<std::size_t>(table.h_size());
+    for (int trial = 0; trial < 10; ++trial) {
+      std::vector<double> cols(4 * 4 * n), out(3 * 4 * nh, 0.0);
+      for (double& v : cols) v = rng() % 7 == 0 ? (rng() % 2 ? 0.0 : -0.0) : u(rng) * std::ldexp(1.0, static_cast<int>(8 * u(rng)));
+      const double* w[4] = {cols.data(), cols.data() + 4 * n, cols.data() + 8 * n, cols.data() + 12 * n};
+      double* h[3] = {out.data(), out.data() + 4 * nh, out.data() + 8 * nh};
+      ASSERT_TRUE(table.gram_sums2x4(w, h));
+      for (std::size_t l = 0; l < 4; ++l) {
+        std::vector<double> lane(6 * n, 0.0), want(3 * nh, 0.0);
+        for (std::size_t a = 0; a < 2; ++a)
+          for (std::size_t x = 0; x < 2; ++x)
+            for (std::size_t i = 0; i < n; ++i) lane[(3 * a + x) * n + i] = w[2 * a + x][4 * i + l];
+        const double* wl[6];
+        for (std::size_t j = 0; j < 6; ++j) wl[j] = lane.data() + j * n;
+        double* hl[3] = {want.data(), want.data() + nh, want.data() + 2 * nh};
+        ASSERT_TRUE(table.gram_sums(wl, 2, hl, 2));
+        for (std::size_t e = 0; e < 3; ++e)
+          for (std::size_t k = 0; k < nh; ++k)
+            ASSERT_EQ(std::bit_cast<std::uint64_t>(h[e][4 * k + l]), std::bit_cast<std::uint64_t>(hl[e][k]))
+                << "entry " << e << " lane " << l << " k " << k;
+      }
+    }
+  }
+}
+
 // A large product (a quadratic pyramid's second frame product: 125 x 27 pairs) has no entry
 // kernel: multiply4 says so and leaves h alone, and the caller multiplies one lane at a time.
 TEST(MuBernsteinProduct, Multiply4DeclinesLargeProducts) {

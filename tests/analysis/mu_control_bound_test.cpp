@@ -14,6 +14,9 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <limits>
+#include <cstdint>
+#include <bit>
 #include <array>
 #include <cmath>
 #include <random>
@@ -158,6 +161,32 @@ TEST(MuControlBound, EigenEnclosure3x3MatchesExactArithmetic) { check_enclosure_
 // lambda_min >= r lambda_max, that holds at the corners of the error box and at random
 // points in it (lambda = q -+ d, so with q > 0 the claim is q (1 - r) >= d (1 + r), squared
 // below); r is drawn at random and within 1e-12 .. 1e-3 of the matrix's own ratio.
+// The 2 x 2 enclosures four matrices at a time (the planar mu lanes): each lane the bits of
+// symmetric_eigen_enclosure<2>'s ratio bounds for its matrix and error, ill-conditioned,
+// indefinite and non-finite ones included.
+TEST(MuControlBound, EnclosureRatiosInLanesAreTheScalarBits) {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int trial = 0; trial < 500; ++trial) {
+    Lanes<4> m[3], err;
+    for (int l = 0; l < 4; ++l) {
+      const double a = std::ldexp(u(rng), static_cast<int>(20 * u(rng))), b = a * (trial % 3 == 0 ? 1e-6 : u(rng));
+      m[0][l] = a * a + b * b;
+      m[1][l] = trial % 5 == 0 ? -m[0][l] : std::abs(u(rng)) * m[0][l];
+      m[2][l] = 0.5 * u(rng) * std::sqrt(std::abs(m[0][l] * m[1][l]));
+      err[l] = std::abs(u(rng)) * 1e-12 * m[0][l];
+    }
+    if (trial == 7) m[0][2] = std::numeric_limits<double>::infinity();
+    const Lanes<4> lo = enclosure_ratio_lower2_lanes<4>(m, err), hi = enclosure_ratio_upper2_lanes(m, err);
+    for (int l = 0; l < 4; ++l) {
+      const double ml[3] = {m[0][l], m[1][l], m[2][l]};
+      const EigenEnclosure e = symmetric_eigen_enclosure<2>(ml, err[l]);
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(lo[l]), std::bit_cast<std::uint64_t>(e.ratio_lower())) << trial << " " << l;
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(hi[l]), std::bit_cast<std::uint64_t>(e.ratio_upper())) << trial << " " << l;
+    }
+  }
+}
+
 TEST(MuControlBound, RatioAtLeast2HoldsInExactArithmetic) {
   std::mt19937 rng(77);
   std::uniform_real_distribution<double> u(-1, 1);
