@@ -127,6 +127,16 @@ int binomial_size(int dim, int degree) {
 // Products with fewer coefficient pairs use the weighted-entry loop (measured, mu_bench).
 constexpr long kEntryKernelBelow = 2048;
 
+// Four lanes of interleaved coefficients (coefficient i of lane l at 4 i + l, as
+// multiply4, multiply_add_sum2x4 and gram_sums2x4 take them): coefficient i's vector.
+typedef double V4 __attribute__((vector_size(32)));
+V4 lanes_at(const double* p, std::size_t i) {
+  V4 v;
+  std::memcpy(&v, p + 4 * i, sizeof v);
+  return v;
+}
+void store_lanes(double* p, std::size_t i, V4 v) { std::memcpy(p + 4 * i, &v, sizeof v); }
+
 }  // namespace
 
 int bernstein_space_size(std::span<const FactorDegree> factors) noexcept {
@@ -554,28 +564,19 @@ bool BernsteinProduct::gram_sums(const double* const* w, int columns, double* co
 
 bool BernsteinProduct::gram_sums2x4(const double* const* w, double* const* h) const {
   if (!entries_kernel_ || pairs_.empty()) return false;
-  typedef double V4 __attribute__((vector_size(32)));
-  const auto at = [](const double* p, int i) {
-    V4 v;
-    std::memcpy(&v, p + 4 * static_cast<std::size_t>(i), sizeof v);
-    return v;
-  };
   // gram_entries<2, 2>'s rows, lane by lane: per entry (a, b), sum_x a_x(i) b_x(j).
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
     V4 acc[3] = {};
     for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
-      const int i = pairs[p].i, j = pairs[p].j;
+      const auto i = static_cast<std::size_t>(pairs[p].i), j = static_cast<std::size_t>(pairs[p].j);
       for (std::size_t e = 0; e < 3; ++e) {
         const auto [a, b] = kGramEntries2[e];
-        const V4 dot = at(w[2 * a], i) * at(w[2 * b], j) + at(w[2 * a + 1], i) * at(w[2 * b + 1], j);
-        acc[e] += pairs[p].w * dot;
+        acc[e] += pairs[p].w * (lanes_at(w[2 * a], i) * lanes_at(w[2 * b], j) + lanes_at(w[2 * a + 1], i) * lanes_at(w[2 * b + 1], j));
       }
     }
-    for (std::size_t e = 0; e < 3; ++e) {
-      const V4 out = at(h[e], k) + acc[e];
-      std::memcpy(h[e] + 4 * static_cast<std::size_t>(k), &out, sizeof out);
-    }
+    for (std::size_t e = 0; e < 3; ++e)
+      store_lanes(h[e], static_cast<std::size_t>(k), lanes_at(h[e], static_cast<std::size_t>(k)) + acc[e]);
   }
   return true;
 }
@@ -642,20 +643,13 @@ void BernsteinProduct::multiply(const double* f, const double* g, double* h) con
 
 bool BernsteinProduct::multiply4(const double* f, const double* g, double* h) const {
   if (!entries_kernel_ || pairs_.empty()) return false;
-  typedef double V4 __attribute__((vector_size(32)));
-  const auto lanes = [](const double* p) {
-    V4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
   // multiply_add's rows, lane by lane: acc summed in the same order, then 0 + 1 * acc.
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
     V4 acc{};
     for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p)
-      acc += pairs[p].w * (lanes(f + 4 * pairs[p].i) * lanes(g + 4 * pairs[p].j));
-    const V4 out = V4{} + 1.0 * acc;
-    std::memcpy(h + 4 * static_cast<std::size_t>(k), &out, sizeof out);
+      acc += pairs[p].w * (lanes_at(f, static_cast<std::size_t>(pairs[p].i)) * lanes_at(g, static_cast<std::size_t>(pairs[p].j)));
+    store_lanes(h, static_cast<std::size_t>(k), V4{} + 1.0 * acc);
   }
   return true;
 }
@@ -663,25 +657,18 @@ bool BernsteinProduct::multiply4(const double* f, const double* g, double* h) co
 bool BernsteinProduct::multiply_add_sum2x4(double s0, const double* f0, const double* g0, double s1,
                                            const double* f1, const double* g1, double* h) const {
   if (!entries_kernel_ || pairs_.empty()) return false;
-  typedef double V4 __attribute__((vector_size(32)));
-  const auto lanes = [](const double* p) {
-    V4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  };
   // fused_entries<2>'s rows, lane by lane.
   const Pair* pairs = pairs_.data();
   for (int k = 0; k < h_size_; ++k) {
     V4 acc{};
     for (int p = row_start_[static_cast<std::size_t>(k)]; p < row_start_[static_cast<std::size_t>(k) + 1]; ++p) {
-      const std::size_t i = 4 * static_cast<std::size_t>(pairs[p].i), j = 4 * static_cast<std::size_t>(pairs[p].j);
+      const auto i = static_cast<std::size_t>(pairs[p].i), j = static_cast<std::size_t>(pairs[p].j);
       V4 sum{};
-      sum += s0 * (lanes(f0 + i) * lanes(g0 + j));
-      sum += s1 * (lanes(f1 + i) * lanes(g1 + j));
+      sum += s0 * (lanes_at(f0, i) * lanes_at(g0, j));
+      sum += s1 * (lanes_at(f1, i) * lanes_at(g1, j));
       acc += pairs[p].w * sum;
     }
-    const V4 out = lanes(h + 4 * static_cast<std::size_t>(k)) + acc;
-    std::memcpy(h + 4 * static_cast<std::size_t>(k), &out, sizeof out);
+    store_lanes(h, static_cast<std::size_t>(k), lanes_at(h, static_cast<std::size_t>(k)) + acc);
   }
   return true;
 }

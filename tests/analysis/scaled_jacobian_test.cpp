@@ -6,15 +6,14 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <random>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "jacobian_test_util.hpp"
+#include "lanes_test_util.hpp"
 #include "scaled_jacobian_test_util.hpp"
 #include "quadval/io.hpp"
 #include "quadval/jacobian_bounds.hpp"
@@ -711,27 +710,8 @@ TEST(ScaledJacobian, FourPlanarElementsInLanesGiveTheirOwnBounds) {
     ASSERT_GE(xs.size(), 20u);
     std::vector<QualityBounds> own;
     for (const auto& x : xs) own.push_back(scaled_jacobian_bounds_given(t, x, o, true, Validity::valid));
-    std::vector<std::size_t> order(xs.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::vector<int> answers(xs.size(), 0);
-    for (int run = 0; run < 2; ++run) {
-      std::shuffle(order.begin(), order.end(), rng);
-      for (std::size_t g = 0; g < order.size(); g += 4) {
-        std::array<std::span<const double>, 4> x;
-        for (std::size_t l = 0; l < 4; ++l) x[l] = xs[order[std::min(g + l, order.size() - 1)]];
-        std::array<QualityBounds, 4> out;
-        const unsigned done = scaled_jacobian_valid_planar4(t, x, o, {}, out);
-        for (std::size_t l = 0; l < 4 && g + l < order.size(); ++l) {
-          if (!((done >> l) & 1u)) continue;
-          const std::size_t i = order[g + l];
-          ++answers[i];
-          EXPECT_EQ(std::bit_cast<std::uint64_t>(out[l].lower), std::bit_cast<std::uint64_t>(own[i].lower)) << i;
-          EXPECT_EQ(std::bit_cast<std::uint64_t>(out[l].upper), std::bit_cast<std::uint64_t>(own[i].upper)) << i;
-          EXPECT_EQ(out[l].subdivisions, own[i].subdivisions) << i;
-          EXPECT_EQ(out[l].tolerance_met, own[i].tolerance_met) << i;
-        }
-      }
-    }
+    const std::vector<int> answers = test::check_four_at_once(
+        xs, own, rng, [&](const auto& x, auto& out) { return scaled_jacobian_valid_planar4(t, x, o, {}, out); });
     for (std::size_t i = 0; i < xs.size(); ++i) {
       EXPECT_NE(answers[i], 1) << "element " << i << " answered in one run only";
       elements += 1;
