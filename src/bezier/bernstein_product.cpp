@@ -656,6 +656,7 @@ bool BernsteinProduct::multiply4(const double* f, const double* g, double* h) co
 
 bool BernsteinProduct::multiply_add_sum2x4(double s0, const double* f0, const double* g0, double s1,
                                            const double* f1, const double* g1, double* h) const {
+  QV_ASSERT(f0 != g0 || f1 != g1, "sums of squares take other rows");
   if (!entries_kernel_ || pairs_.empty()) return false;
   // fused_entries<2>'s rows, lane by lane.
   const Pair* pairs = pairs_.data();
