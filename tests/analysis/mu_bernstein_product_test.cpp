@@ -378,8 +378,9 @@ TEST(MuBernsteinProduct, TwoTermSumsInLanesEqualEachLaneBitForBit) {
   }
   const BernsteinProduct& large = bernstein_product(std::vector<FactorDegree>{{1, 4}, {1, 4}, {1, 4}},
                                                     std::vector<FactorDegree>{{1, 4}, {1, 4}, {1, 4}});
-  std::vector<double> f(4 * static_cast<std::size_t>(large.f_size()), 1.0), h(4 * static_cast<std::size_t>(large.h_size()), -7.0);
-  EXPECT_FALSE(large.multiply_add_sum2x4(1.0, f.data(), f.data(), -1.0, f.data(), f.data(), h.data()));
+  std::vector<double> f(4 * static_cast<std::size_t>(large.f_size()), 1.0), g = f;
+  std::vector<double> h(4 * static_cast<std::size_t>(large.h_size()), -7.0);
+  EXPECT_FALSE(large.multiply_add_sum2x4(1.0, f.data(), g.data(), -1.0, g.data(), f.data(), h.data()));
   EXPECT_TRUE(std::all_of(h.begin(), h.end(), [](double v) { return v == -7.0; }));
 }
 
