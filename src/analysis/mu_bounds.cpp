@@ -465,7 +465,6 @@ namespace {
 unsigned planar_mu_roots(const MuSpace& space, const std::array<std::span<const double>, 4>& nodes, double tol,
                          std::array<QualityBounds, 4>& out) {
   using V = Lanes<4>;
-  constexpr double kInf = std::numeric_limits<double>::infinity();
   const auto up = [](V x) { return lanes3::up<4>(x); };
   const int n = space.num_nodes();
   const auto nn = static_cast<std::size_t>(n);
@@ -475,18 +474,7 @@ unsigned planar_mu_roots(const MuSpace& space, const std::array<std::span<const 
   // element_w: x_i - x_0, their range, X_c's control values, W_j = sum_c Jinv_cj X_c.
   d.resize(2 * nn);
   V range{};
-  for (std::size_t l = 0; l < 4; ++l) {
-    const double* x = nodes[l].data();
-    double r = 0;
-    for (std::size_t i = 0; i < nn; ++i) {
-      for (std::size_t c = 0; c < 3; ++c) r = std::max(r, std::abs(x[3 * i + c] - x[c]));
-      if (x[3 * i + 2] - x[2] != 0) return 0;
-      d[2 * i][l] = x[3 * i] - x[0];
-      d[2 * i + 1][l] = x[3 * i + 1] - x[1];
-    }
-    if (!(r < kInf)) return 0;
-    range[l] = r;
-  }
+  if (!planar_differences(nodes, nn, d.data(), range)) return 0;
   xc.resize(4 * ws);  // (c, a) at (2 c + a) ws
   for (int c = 0; c < 2; ++c) space.derivative_nonzeros(c).rows_times_planar_lanes(d.data(), xc.data() + 2 * c * ws);
   w.resize(4 * ws);  // (j, a) at (2 j + a) ws

@@ -620,18 +620,7 @@ bool planar_lanes_input(const ScaledJacobianSpace& space, const std::array<std::
   // 1. The node differences x_i - x_0 and their range, as columns_and_jacobian takes them.
   ws.d.resize(2 * nn);
   V range{};
-  for (std::size_t l = 0; l < 4; ++l) {
-    const double* x = nodes[l].data();
-    double r = 0;
-    for (std::size_t i = 0; i < nn; ++i) {
-      for (std::size_t j = 0; j < 3; ++j) r = std::max(r, std::abs(x[3 * i + j] - x[j]));
-      if (x[3 * i + 2] - x[2] != 0) return false;
-      ws.d[2 * i][l] = x[3 * i] - x[0];
-      ws.d[2 * i + 1][l] = x[3 * i + 1] - x[1];
-    }
-    if (!(r < kInf)) return false;
-    range[l] = r;
-  }
+  if (!planar_differences(nodes, nn, ws.d.data(), range)) return false;
   // 2. The columns' coefficients, error bounds and magnitudes (z: zeros, magnitude 0).
   std::array<V, 2> err, mag_x, mag_y;
   for (std::size_t c = 0; c < 2; ++c) {

@@ -9,13 +9,39 @@
 // (four_rows_times_points, the same bits again), which is faster where the rows are short
 // chains of additions. Internal to src/analysis.
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
+#include <span>
 #include <vector>
 
 #include "analysis/lane_vector.hpp"
 
 namespace quadval {
+
+/// The node differences x_i - x_0 of four elements, element l in lane l (d[2 i + a]:
+/// coordinate a < 2 of node i, as rows_times_planar_lanes takes them), and each element's
+/// range max_{i, a < 3} |x_i,a - x_0,a| as the per-element maps take it. false where an
+/// element is not in a plane z = const or its range is not finite.
+inline bool planar_differences(const std::array<std::span<const double>, 4>& nodes, std::size_t nn, Lanes<4>* d,
+                               Lanes<4>& range) {
+  for (std::size_t l = 0; l < 4; ++l) {
+    const double* x = nodes[l].data();
+    double r = 0;
+    for (std::size_t i = 0; i < nn; ++i) {
+      for (std::size_t a = 0; a < 3; ++a) r = std::max(r, std::abs(x[3 * i + a] - x[a]));
+      if (x[3 * i + 2] - x[2] != 0) return false;
+      d[2 * i][l] = x[3 * i] - x[0];
+      d[2 * i + 1][l] = x[3 * i + 1] - x[1];
+    }
+    if (!(r < std::numeric_limits<double>::infinity())) return false;
+    range[l] = r;
+  }
+  return true;
+}
 
 struct SparseRows {
   std::vector<std::uint32_t> start;  ///< row r: entries [start[r], start[r + 1])
