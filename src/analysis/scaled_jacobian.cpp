@@ -74,6 +74,14 @@ constexpr int kPairedSplits = 8;
 // tetrahedra that 8 splits leave unsettled take 57-74 of those ms (17-22 in this stage):
 // more splits settle some of them, at more than the full path costs them.
 constexpr int kSignedSplits = 8;
+// Where the signed stage's root bound is at the Hadamard floor -s, tetrahedra go to the full
+// bounds at once: 8 splits settled 27 of the 133 such inverted elements of
+// warped_tetrahedron_o3 and none stuck there after 3 splits, and the full bounds settle them
+// for less than the splits cost. Each inverted element best of 3, one thread, two runs:
+// warped_tetrahedron_o3 56.6 -> 45.4 ms, tets_h0.8_o2 0.27 -> 0.23 ms, mixed_h0.6_o2's
+// tetrahedra 14.0 -> 13.6 ms. Not for the others: warped_pyramid_o2 0.63 -> 1.7 ms,
+// mixed_h0.6_o2's hexahedra 0.25 -> 0.93 ms (its pyramids 14.1 -> 13.2 ms).
+bool signed_floor_root_ends(const ElementType& type) { return type.family == ElementFamily::tetrahedron; }
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
 // rounding of at most u per operation; the final bounds are enlarged by 1% to cover the
@@ -584,11 +592,12 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
 }
 
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
-                                           int max_splits) {
+                                           int max_splits, bool floor_root_ends) {
   QV_ASSERT(scaled_jacobian_supported(type) && type.dim >= 2 && nodes.size() == static_cast<std::size_t>(type.num_nodes) * 3,
             "signed stage of " << type.name);
   const ScaledJacobianSpace& space = scaled_jacobian_space(type);
-  return signed_quotient_bounds(space, element_input(space, nodes, /*planar=*/type.dim == 2), tol, max_splits);
+  return signed_quotient_bounds(space, element_input(space, nodes, /*planar=*/type.dim == 2), tol, max_splits, 0.0,
+                                nullptr, floor_root_ends);
 }
 
 SjProbe scaled_jacobian_probe(const ElementType& type, std::span<const double> nodes, double enough) {
@@ -756,7 +765,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   if (v == Validity::invalid && (dim == 3 || (dim == 2 && !area))) {
     const QuotientInput in = quotient_input(polys, udim);
     const int splits = std::min(kSignedSplits, options.max_subdivisions);
-    quick = signed_quotient_bounds(space, in, options.abs_tol, splits, 0.0, &quick_frames);
+    quick = signed_quotient_bounds(space, in, options.abs_tol, splits, 0.0, &quick_frames, signed_floor_root_ends(type));
     if (quick.tolerance_met) return quick;
     // Not settled, in 2D with the lower bound at the floor -s (a fold: the columns at right
     // angles, the wrong way round): that bound is sharp, and only the upper bound, from the
@@ -768,7 +777,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
     const bool at_floor = dim == 2 && quick.lower <= -space.s_hi();
     const double probed = at_floor ? probe_scaled_jacobian(space, in, quick.lower + 0.5 * options.abs_tol).upper : 0.0;
     if (probed < quick.upper) {
-      quick = signed_quotient_bounds(space, in, options.abs_tol, splits, probed, &quick_frames);
+      quick = signed_quotient_bounds(space, in, options.abs_tol, splits, probed, &quick_frames,
+                                     signed_floor_root_ends(type));
       if (quick.tolerance_met) return quick;
     }
   }

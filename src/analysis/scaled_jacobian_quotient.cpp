@@ -862,8 +862,9 @@ class Quotient {
 };
 
 // Which bound the leaves get: Quotient::bound (split into 2^dim children), signed_bound or
-// paired_bound (single bisections).
-enum class Pairing { none, signs, positive };
+// paired_bound (single bisections); signs_unless_floor: signed_bound, not refined where the
+// root's bound is at the Hadamard floor.
+enum class Pairing { none, signs, signs_unless_floor, positive };
 
 QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, double tol, int max_splits,
                      Pairing pairing, QualityBounds out, FrameBounds* frame_lower);
@@ -889,13 +890,14 @@ QualityBounds quotient_bounds(const ScaledJacobianSpace& space, const QuotientIn
 }
 
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                                     int max_splits, double upper, FrameBounds* frame_lower) {
+                                     int max_splits, double upper, FrameBounds* frame_lower, bool floor_root_ends) {
   QualityBounds out;
   out.lower = -kInf;
   out.upper = std::min(upper, 0.0);  // J <= 0 at a point, where sj <= 0
   if (frame_lower) frame_lower->fill(-kInf);
   if (layout_of(space, shape_of(in)).triple.empty()) return out;  // L_k outside J's space (2D)
-  return refine(space, in, tol, max_splits, Pairing::signs, out, frame_lower);
+  return refine(space, in, tol, max_splits, floor_root_ends ? Pairing::signs_unless_floor : Pairing::signs, out,
+                frame_lower);
 }
 
 namespace {
@@ -925,13 +927,14 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   FrameBounds settled_frames;  // the same per frame
   settled_frames.fill(kInf);
   long next_id = 0;
+  const bool with_signs = pairing == Pairing::signs || pairing == Pairing::signs_unless_floor;
   const auto cmp = [](const Leaf& a, const Leaf& b) { return a.lower != b.lower ? a.lower > b.lower : a.id > b.id; };
   const auto push = [&](int slot) {
     const auto s = static_cast<std::size_t>(slot);
     const double* leaf = pool.data() + s * stride;
     FrameBounds& frames = pool_frames[s];
     frames.fill(kInf);
-    const double lo = pairing == Pairing::signs      ? q.signed_bound(leaf, pool_err[s], out.upper, frames)
+    const double lo = with_signs ? q.signed_bound(leaf, pool_err[s], out.upper, frames)
                       : pairing == Pairing::positive ? q.paired_bound(leaf, pool_err[s], out.upper, frames)
                                                      : q.bound(leaf, pool_err[s], out.upper, frames);
     if (up(out.upper - lo) <= tol) {
@@ -950,6 +953,8 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   if (pairing == Pairing::none && !heap.empty() && up(out.upper - heap.front().lower) > kReachable * tol)
     max_splits = 0;
   if (pairing == Pairing::positive && !heap.empty() && up(out.upper - heap.front().lower) > kPairedReachable * tol)
+    max_splits = 0;
+  if (pairing == Pairing::signs_unless_floor && !heap.empty() && heap.front().lower <= -space.s_hi())
     max_splits = 0;
   thread_local std::vector<double> parent;
   parent.resize(stride);

@@ -111,8 +111,12 @@ unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const QuotientL
 /// planar 2D, with the bound of signed_bound (scaled_jacobian_quotient.cpp) that keeps J's
 /// signs: refined by at most max_splits best-first splits, from `upper` (a certified upper
 /// bound of sj(E), at most 0). Nothing (lower = -inf, upper) where J does not lie in the
-/// space of the product of the columns (none of the 2D and 3D types).
+/// space of the product of the columns (none of the 2D and 3D types). floor_root_ends: no
+/// split where the root's bound is at the Hadamard floor -s (a frame column turning
+/// through a fold on the element), for the families where the full bounds settle such
+/// elements for less than these splits cost (tetrahedra, scaled_jacobian.cpp).
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
-                                     int max_splits, double upper = 0, FrameBounds* frame_lower = nullptr);
+                                     int max_splits, double upper = 0, FrameBounds* frame_lower = nullptr,
+                                     bool floor_root_ends = false);
 
 }  // namespace quadval

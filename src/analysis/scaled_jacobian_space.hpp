@@ -93,9 +93,9 @@ QualityBounds scaled_jacobian_quotient_stage(const ElementType& type, std::span<
 /// The signed first stage on its own (tests): bounds of sj(E) of a 3D element, or a 2D one
 /// in a plane z = const, where J <= 0 was found at a point (the caller's claim: upper starts at 0), from J's coefficients with
 /// their signs and the columns (scaled_jacobian_quotient.hpp), refined by at most max_splits
-/// splits.
+/// splits; floor_root_ends as for signed_quotient_bounds.
 QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<const double> nodes, double tol,
-                                           int max_splits);
+                                           int max_splits, bool floor_root_ends = false);
 
 /// Tests only: switch off (on by default), in the calling thread, the closed-form bounds of
 /// valid straight-sided simplices (planar triangles, tetrahedra: columns within the

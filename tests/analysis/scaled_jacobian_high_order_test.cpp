@@ -14,6 +14,7 @@
 #include <random>
 #include <vector>
 
+#include "analysis/scaled_jacobian_space.hpp"
 #include "jacobian_test_util.hpp"
 #include "scaled_jacobian_test_util.hpp"
 #include "quadval/bezier_basis.hpp"
@@ -341,6 +342,40 @@ TEST(ScaledJacobianHighOrder, MeshElementsAroundVanishingColumnsConverge) {
       }
   }
   EXPECT_EQ(checked, 4);
+}
+
+// The signed stage asked to end where its root's bound is at the Hadamard floor (as for
+// tetrahedra): on the inverted cubic tetrahedra of the warped mesh it makes no split
+// exactly there, and elsewhere gives the same bounds as without the request.
+TEST(ScaledJacobianHighOrder, SignedStageEndsAtAFloorRootOnlyWhereAsked) {
+  const Mesh mesh = read_mesh(std::string(QUADVAL_SHARED_DIR) + "/data/curved/warped_tetrahedron_o3_N6_a0.25.msh");
+  const double floor = -std::sqrt(2.0);
+  int at_floor = 0, above = 0;
+  for (const ElementBlock& blk : mesh.blocks) {
+    if (blk.type->dim != 3) continue;
+    const ElementType& t = *blk.type;
+    for (std::size_t e = 0; e < blk.size(); e += 2) {
+      const std::vector<double> x = test::element_coordinates(mesh, blk, e);
+      if (!(bounds(t, x, 1e-2).upper < 0)) continue;
+      SCOPED_TRACE("element " + std::to_string(blk.tags[e]));
+      const QualityBounds root = scaled_jacobian_signed_stage(t, x, 1e-2, 0);
+      const QualityBounds plain = scaled_jacobian_signed_stage(t, x, 1e-2, 8);
+      const QualityBounds asked = scaled_jacobian_signed_stage(t, x, 1e-2, 8, true);
+      if (root.lower <= floor + 1e-12) {
+        ++at_floor;
+        EXPECT_EQ(asked.subdivisions, 0);
+        EXPECT_EQ(asked.lower, root.lower);
+        EXPECT_EQ(asked.upper, root.upper);
+      } else {
+        ++above;
+        EXPECT_EQ(asked.lower, plain.lower);
+        EXPECT_EQ(asked.upper, plain.upper);
+        EXPECT_EQ(asked.subdivisions, plain.subdivisions);
+      }
+    }
+  }
+  EXPECT_GT(at_floor, 20);  // 133 of the 668 inverted, all elements
+  EXPECT_GT(above, 100);
 }
 
 TEST(ScaledJacobianHighOrder, InvertedMeshElementsEncloseTheSampledMinimum) {
