@@ -497,6 +497,45 @@ thread_local bool use_straight_path = true;
 // norms' own few ulps are covered by 1 +- 1e-12, J_1's rounding by linear_jacobian's err.
 // The minimum over the frames of each bound bounds min sj. Nothing when the element is not
 // such a simplex or the bounds are wider than tol.
+// The frame columns of a simplex that differ other than in sign, as weights of the edges
+// (first nonzero weight positive), and per frame k its column j's index among them.
+struct SimplexFrameColumns {
+  std::size_t count = 0;
+  std::array<std::array<int, 3>, 6> weight{};
+  std::array<std::array<std::size_t, 3>, 4> of{};
+};
+
+SimplexFrameColumns make_simplex_frame_columns(const ScaledJacobianSpace& space) {
+  SimplexFrameColumns fc;
+  const auto dim = static_cast<std::size_t>(space.dim());
+  QV_ASSERT(space.frames().size() <= fc.of.size(), space.frames().size() << " frames");
+  for (std::size_t k = 0; k < space.frames().size(); ++k)
+    for (std::size_t j = 0; j < dim; ++j) {
+      std::array<int, 3> w = space.frames()[k][j];
+      const int first = *std::find_if(w.begin(), w.end(), [](int x) { return x != 0; });
+      if (first < 0)
+        for (int& x : w) x = -x;
+      std::size_t d = 0;
+      while (d < fc.count && fc.weight[d] != w) ++d;
+      if (d == fc.count) {
+        QV_ASSERT(fc.count < fc.weight.size(), "more than 6 frame columns");
+        fc.weight[fc.count++] = w;
+      }
+      fc.of[k][j] = d;
+    }
+  return fc;
+}
+
+// Built once per simplex family (tetrahedra, planar triangles).
+const SimplexFrameColumns& simplex_frame_columns(const ScaledJacobianSpace& space) {
+  if (space.type().family == ElementFamily::tetrahedron) {
+    static const SimplexFrameColumns tet = make_simplex_frame_columns(space);
+    return tet;
+  }
+  static const SimplexFrameColumns triangle = make_simplex_frame_columns(space);
+  return triangle;
+}
+
 std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& space, std::span<const double> x,
                                                      bool planar, double tol, const KnownMargin* known) {
   const ElementType& type = space.type();
@@ -528,20 +567,30 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
   // least quotients by kSlack (about 9e4 u) covers them all; directed roundings at every
   // step cost twice as much on straight tetrahedra.
   constexpr double kSlack = 1e-11, kSmall = 0x1p-300, kLarge = 0x1p300;
+  // Each distinct frame column's norm and error once (a tetrahedron's 4 corner frames use
+  // its 6 edges, a triangle's 3 frames its 3; -v has exactly the norm of v).
+  const SimplexFrameColumns& fc = simplex_frame_columns(space);
+  std::array<double, 6> col_norm{}, col_err{};
+  for (std::size_t d = 0; d < fc.count; ++d) {
+    double v[3] = {0, 0, 0}, e = 0;
+    for (std::size_t c = 0; c < dim; ++c) {
+      const int w = fc.weight[d][c];
+      if (w == 0) continue;
+      for (std::size_t k = 0; k < 3; ++k) v[k] += w * a[c][k];
+      e += beta[c] + 4 * kUnit * a_norm1[c];
+    }
+    const double norm = sqrt_rn(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if (!(norm >= kSmall && norm <= kLarge && e <= 0.5 * norm)) return std::nullopt;
+    col_norm[d] = norm;
+    col_err[d] = e;
+  }
   double lower = kInf, upper = kInf;
-  for (const Frame& fr : space.frames()) {
+  for (std::size_t k = 0; k < space.frames().size(); ++k) {
     double den_hi = 1, den_lo = 1;
     for (std::size_t j = 0; j < dim; ++j) {
-      double v[3] = {0, 0, 0}, e = 0;
-      for (std::size_t c = 0; c < dim; ++c) {
-        if (fr[j][c] == 0) continue;
-        for (std::size_t k = 0; k < 3; ++k) v[k] += fr[j][c] * a[c][k];
-        e += beta[c] + 4 * kUnit * a_norm1[c];
-      }
-      const double norm = sqrt_rn(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-      if (!(norm >= kSmall && norm <= kLarge && e <= 0.5 * norm)) return std::nullopt;
-      den_hi *= norm + e;
-      den_lo *= norm - e;
+      const std::size_t d = fc.of[k][j];
+      den_hi *= col_norm[d] + col_err[d];
+      den_lo *= col_norm[d] - col_err[d];
     }
     lower = std::min(lower, j_lo / den_hi);
     upper = std::min(upper, j_hi / den_lo);
