@@ -27,6 +27,7 @@
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
+#include "analysis/symmetric3_lanes.hpp"
 #include "analysis/trilinear_hex_sj.hpp"
 #include "bezier/bernstein_bisection.hpp"
 #include "bezier/bernstein_product.hpp"
@@ -488,15 +489,6 @@ void columns_and_jacobian(const ScaledJacobianSpace& space, std::span<const doub
 
 thread_local bool use_straight_path = true;
 
-// A valid straight-sided simplex (planar triangle, tetrahedron; order 1, or higher with a
-// finite straight_sided.hpp margin): its columns are the edges a_c = x_c - x_0 up to beta_c
-// (0 at order 1) and J is J_1 up to the margin m, so on the whole element each frame's
-// s J / prod_j |v_j| lies between s (J_1 - m) / prod (|v~_j| + e_j) and s (J_1 + m) / prod
-// (|v~_j| - e_j), v~_j the frame's columns computed from the edges and e_j the sum of
-// beta_c over its columns plus 4u of their 1-norms (the edges' and sums' roundings); the
-// norms' own few ulps are covered by 1 +- 1e-12, J_1's rounding by linear_jacobian's err.
-// The minimum over the frames of each bound bounds min sj. Nothing when the element is not
-// such a simplex or the bounds are wider than tol.
 // The frame columns of a simplex that differ other than in sign, as weights of the edges
 // (first nonzero weight positive), and per frame k its column j's index among them.
 struct SimplexFrameColumns {
@@ -536,6 +528,84 @@ const SimplexFrameColumns& simplex_frame_columns(const ScaledJacobianSpace& spac
   return triangle;
 }
 
+// One-ulp steps and square roots of T = double or lanes: the lanes' are next_up, next_down
+// and sqrt's bits (symmetric3_lanes.hpp).
+using LaneBlock = Lanes<kNativeLanes>;
+LaneBlock up(LaneBlock x) { return lanes3::up<kNativeLanes>(x); }
+LaneBlock down(LaneBlock x) { return lanes3::down<kNativeLanes>(x); }
+double root(double x) { return sqrt_rn(x); }
+LaneBlock root(LaneBlock x) { return lanes3::root<kNativeLanes>(x); }
+
+template <class T>
+struct StraightSj {
+  T lower{}, upper{};
+  decltype(T{} < T{}) ok{};  ///< where these bounds hold and meet the tolerance
+};
+
+// A valid straight-sided simplex (planar triangle, tetrahedron; order 1, or higher with a
+// finite straight_sided.hpp margin): its columns are the edges a_c = x_c - x_0 up to beta_c
+// (0 at order 1) and J is J_1 (within err) up to the margin m, so on the whole element each
+// frame's s J / prod_j |v_j| lies between s (J_1 - m) / prod (|v~_j| + e_j) and
+// s (J_1 + m) / prod (|v~_j| - e_j), v~_j the frame's columns computed from the edges and
+// e_j the sum of beta_c over its columns plus 4u of their 1-norms (the edges' and sums'
+// roundings); the norms' own few ulps are covered by 1 +- 1e-12, J_1's rounding by
+// linear_jacobian's err. The minimum over the frames of each bound bounds min sj. Not ok
+// where the bounds are wider than tol (or a step below fails).
+// T = double for one element, LaneBlock for one element per lane: the same operations, so
+// the same bits (straight_tet_sj_lanes).
+template <class T>
+StraightSj<T> straight_simplex_sj(const ScaledJacobianSpace& space, const std::array<std::array<T, 3>, 3>& a,
+                                  const std::array<T, 3>& beta, T m, T j1, T err, double tol) {
+  StraightSj<T> out;
+  const T j_lo = down(down(j1 - err) - m), j_hi = up(up(j1 + err) + m);
+  out.ok = (j_lo > 0) & (j_hi < kInf);
+  const auto dim = static_cast<std::size_t>(space.dim());
+  std::array<T, 3> a_norm1{};  // the edges' 1-norms
+  for (std::size_t c = 0; c < dim; ++c)
+    for (std::size_t j = 0; j < 3; ++j) a_norm1[c] += vabs(a[c][j]);
+  // In plain arithmetic: every quantity below is nonnegative and its norms lie in
+  // [2^-300, 2^300] (else the general path), so nothing underflows or overflows, and each
+  // operation adds a relative error of at most u (the differences norm - e too, as e is at
+  // most half the norm). Fewer than 40 roundings reach a frame's quotient, so widening the
+  // least quotients by kSlack (about 9e4 u) covers them all; directed roundings at every
+  // step cost twice as much on straight tetrahedra.
+  constexpr double kSlack = 1e-11, kSmall = 0x1p-300, kLarge = 0x1p300;
+  // Each distinct frame column's norm and error once (a tetrahedron's 4 corner frames use
+  // its 6 edges, a triangle's 3 frames its 3; -v has exactly the norm of v).
+  const SimplexFrameColumns& fc = simplex_frame_columns(space);
+  std::array<T, 6> col_norm{}, col_err{};
+  for (std::size_t d = 0; d < fc.count; ++d) {
+    T v[3] = {}, e{};
+    for (std::size_t c = 0; c < dim; ++c) {
+      const int w = fc.weight[d][c];
+      if (w == 0) continue;
+      for (std::size_t k = 0; k < 3; ++k) v[k] += w * a[c][k];
+      e += beta[c] + 4 * kUnit * a_norm1[c];
+    }
+    const T norm = root(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    out.ok = out.ok & (norm >= kSmall) & (norm <= kLarge) & (e <= 0.5 * norm);
+    col_norm[d] = norm;
+    col_err[d] = e;
+  }
+  T lower = T{} + kInf, upper = T{} + kInf;
+  for (std::size_t k = 0; k < space.frames().size(); ++k) {
+    T den_hi = T{} + 1, den_lo = T{} + 1;
+    for (std::size_t j = 0; j < dim; ++j) {
+      const std::size_t d = fc.of[k][j];
+      den_hi *= col_norm[d] + col_err[d];
+      den_lo *= col_norm[d] - col_err[d];
+    }
+    lower = vmin(lower, j_lo / den_hi);
+    upper = vmin(upper, j_hi / den_lo);
+  }
+  out.lower = down(space.s_lo() * lower * (1 - kSlack));
+  out.upper = up(space.s_hi() * upper * (1 + kSlack));
+  out.ok = out.ok & (up(out.upper - out.lower) <= tol);
+  return out;
+}
+
+// straight_simplex_sj of one element from its nodes; nothing when it is not such a
+// simplex or the bounds are wider than tol.
 std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& space, std::span<const double> x,
                                                      bool planar, double tol, const KnownMargin* known) {
   const ElementType& type = space.type();
@@ -550,60 +620,34 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
   const LinearKind kind = triangle ? LinearKind::triangle : LinearKind::tetrahedron;
   double j1 = 0;
   const double err = linear_jacobian_coefficients(kind, x.data(), &j1);
-  const double j_lo = down(down(j1 - err) - m), j_hi = up(up(j1 + err) + m);
-  if (!(j_lo > 0) || !(j_hi < kInf)) return std::nullopt;
-  const std::size_t dim = type.dim == 2 ? 2 : 3;
-  std::array<std::array<double, 3>, 3> a{};  // edges a_c, and their 1-norms
-  std::array<double, 3> a_norm1{0, 0, 0};
-  for (std::size_t c = 0; c < dim; ++c)
-    for (std::size_t j = 0; j < 3; ++j) {
-      a[c][j] = x[3 * (c + 1) + j] - x[j];
-      a_norm1[c] += std::abs(a[c][j]);
-    }
-  // In plain arithmetic: every quantity below is nonnegative and its norms lie in
-  // [2^-300, 2^300] (else the general path), so nothing underflows or overflows, and each
-  // operation adds a relative error of at most u (the differences norm - e too, as e is at
-  // most half the norm). Fewer than 40 roundings reach a frame's quotient, so widening the
-  // least quotients by kSlack (about 9e4 u) covers them all; directed roundings at every
-  // step cost twice as much on straight tetrahedra.
-  constexpr double kSlack = 1e-11, kSmall = 0x1p-300, kLarge = 0x1p300;
-  // Each distinct frame column's norm and error once (a tetrahedron's 4 corner frames use
-  // its 6 edges, a triangle's 3 frames its 3; -v has exactly the norm of v).
-  const SimplexFrameColumns& fc = simplex_frame_columns(space);
-  std::array<double, 6> col_norm{}, col_err{};
-  for (std::size_t d = 0; d < fc.count; ++d) {
-    double v[3] = {0, 0, 0}, e = 0;
-    for (std::size_t c = 0; c < dim; ++c) {
-      const int w = fc.weight[d][c];
-      if (w == 0) continue;
-      for (std::size_t k = 0; k < 3; ++k) v[k] += w * a[c][k];
-      e += beta[c] + 4 * kUnit * a_norm1[c];
-    }
-    const double norm = sqrt_rn(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    if (!(norm >= kSmall && norm <= kLarge && e <= 0.5 * norm)) return std::nullopt;
-    col_norm[d] = norm;
-    col_err[d] = e;
-  }
-  double lower = kInf, upper = kInf;
-  for (std::size_t k = 0; k < space.frames().size(); ++k) {
-    double den_hi = 1, den_lo = 1;
-    for (std::size_t j = 0; j < dim; ++j) {
-      const std::size_t d = fc.of[k][j];
-      den_hi *= col_norm[d] + col_err[d];
-      den_lo *= col_norm[d] - col_err[d];
-    }
-    lower = std::min(lower, j_lo / den_hi);
-    upper = std::min(upper, j_hi / den_lo);
-  }
-  QualityBounds out{down(space.s_lo() * lower * (1 - kSlack)), up(space.s_hi() * upper * (1 + kSlack)), 0, false};
-  out.tolerance_met = up(out.upper - out.lower) <= tol;
-  if (!out.tolerance_met) return std::nullopt;
-  return out;
+  std::array<std::array<double, 3>, 3> a{};  // the edges
+  for (std::size_t c = 0; c < static_cast<std::size_t>(type.dim); ++c)
+    for (std::size_t j = 0; j < 3; ++j) a[c][j] = x[3 * (c + 1) + j] - x[j];
+  const StraightSj<double> sj = straight_simplex_sj(space, a, beta, m, j1, err, tol);
+  if (!sj.ok) return std::nullopt;
+  return QualityBounds{sj.lower, sj.upper, 0, true};
 }
 
 }  // namespace
 
 void scaled_jacobian_use_straight_path(bool on) noexcept { use_straight_path = on; }
+
+unsigned straight_tet_sj_lanes(const ElementType& type, const LaneBlock* edges, const LaneBlock* beta,
+                               LaneBlock margin, double tol, QualityBounds* out) {
+  if (!use_straight_path || type.family != ElementFamily::tetrahedron) return 0;
+  LaneBlock j1;
+  const LaneBlock err = linear_tet_jacobian_lanes(edges, j1);
+  std::array<std::array<LaneBlock, 3>, 3> a;
+  for (std::size_t c = 0; c < 3; ++c)
+    for (std::size_t j = 0; j < 3; ++j) a[c][j] = edges[3 * c + j];
+  // A first-order element's margins are 0, as the element alone takes them.
+  const StraightSj<LaneBlock> sj =
+      straight_simplex_sj(scaled_jacobian_space(type), a, {beta[0], beta[1], beta[2]}, margin, j1, err, tol);
+  const unsigned done = lanes3::mask_bits<kNativeLanes>(sj.ok & (margin < kInf));
+  for (int l = 0; l < kNativeLanes; ++l)
+    if ((done >> l) & 1u) out[l] = QualityBounds{sj.lower[l], sj.upper[l], 0, true};
+  return done;
+}
 
 QualityBounds scaled_jacobian_bounds(const ElementType& type, std::span<const double> nodes,
                                      const QualityOptions& options, bool planar) {

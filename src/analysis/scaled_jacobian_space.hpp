@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "analysis/jacobian_space.hpp"
+#include "analysis/lane_vector.hpp"
 #include "analysis/sparse_rows.hpp"
 #include "analysis/straight_sided.hpp"
 #include "bezier/bernstein_bisection.hpp"
@@ -128,5 +129,14 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
 unsigned scaled_jacobian_valid_planar4(const ElementType& type, const std::array<std::span<const double>, 4>& nodes,
                                        const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
                                        std::array<QualityBounds, 4>& out);
+
+/// scaled_jacobian_bounds_given of kNativeLanes valid straight-sided tetrahedra of `type` at
+/// once, where the closed form of straight-sided simplices settles them (the same bits):
+/// edges[3 c + j]: coordinate j of x_{c+1} - x_0 per lane (computed from the nodes); beta[c]
+/// and margin: the straight-sided margins of column c and of J that call gets (0 for first
+/// order). Bit l is set where out[l] holds lane l's bounds; the other lanes need the call.
+unsigned straight_tet_sj_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
+                               const Lanes<kNativeLanes>* beta, Lanes<kNativeLanes> margin, double tol,
+                               QualityBounds* out);
 
 }  // namespace quadval
