@@ -31,6 +31,9 @@ shared tri_h0.4_o4 and quad_h0.4_o2) at size H, in quartic triangles or quadrati
 quadrangles, and moves every node by a smooth field of amplitude 0.35 H: curved, valid
 elements throughout (tri:0.05 gives 51,205 triangles, quad:0.08 10,030 quadrangles), where
 the shared plates are straight inside and curved only along their boundaries.
+
+--tet-box H meshes, with Gmsh, the unit cube in first-order tetrahedra of size H (0.03 gives
+178,255), the commonest large mesh: straight-sided, all valid.
 """
 import argparse
 import glob
@@ -120,12 +123,36 @@ def curved_plate(spec):
     return path
 
 
+def tet_box(h):
+    """The --tet-box mesh: Gmsh's first-order tetrahedra of the unit cube at size h, cached."""
+    if not h > 0:
+        raise SystemExit("--tet-box wants a size H > 0, not %r" % h)
+    path = os.path.join(CACHE, "tet_box_h%g.msh" % h)
+    if os.path.exists(path):
+        return path
+    import gmsh
+    os.makedirs(CACHE, exist_ok=True)
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+        gmsh.model.occ.synchronize()
+        gmsh.option.setNumber("Mesh.MeshSizeMax", h)
+        gmsh.model.mesh.generate(3)
+        gmsh.option.setNumber("Mesh.Binary", 1)
+        gmsh.write(path)
+    finally:
+        gmsh.finalize()
+    return path
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quadval", default=os.path.join(HERE, "..", "build", "quadval"))
     ap.add_argument("--threads", type=int, default=0)
     ap.add_argument("--hex-box", type=int, nargs="*", default=[])
     ap.add_argument("--plate", nargs="*", default=[], help="tri:H / quad:H: a curved plate meshed by Gmsh (see the top)")
+    ap.add_argument("--tet-box", type=float, nargs="*", default=[], help="H: the unit cube in first-order tetrahedra of size H")
     ap.add_argument("--meshes", nargs="*", default=None)
     ap.add_argument("--quality", action="store_true", help="mu vs ICN and scaled Jacobian vs IGE")
     ap.add_argument("--tol", type=float, default=1e-2, help="quadval --tol for mu / scaled Jacobian")
@@ -136,6 +163,7 @@ def main():
     meshes = a.meshes or sorted(glob.glob(os.path.join(SHARED, "curved", "*.msh")))
     meshes += [hex_box(n) for n in a.hex_box]
     meshes += [curved_plate(p) for p in a.plate]
+    meshes += [tet_box(h) for h in a.tet_box]
     tool = os.path.join(SHARED, "tools", "gmsh_analyse.py")
     if a.quality:
         quality(a, meshes, tool)

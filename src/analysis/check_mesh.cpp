@@ -522,19 +522,11 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             const auto lane_of = [&](const unsigned* done, std::vector<QualityBounds>& lane, std::size_t i) {
               return ((done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane[i] : nullptr;
             };
-            // mu and the scaled Jacobian of an element decided by the first-order chunk: from
-            // its lanes (tet_lanes_of) where they settled it, else from its nodes. Kept out of
-            // finish_first_order, which validity alone calls per element: as one function,
-            // validity of 178k first-order tetrahedra took 9% longer.
+            // mu and the scaled Jacobian of an element decided by the first-order chunk, from
+            // its nodes, where its chunk's lanes (tet_lanes_of) did not settle them.
             const auto first_order_qualities = [&](std::size_t index, std::size_t element, Validity v,
-                                                   const KnownMargin* known, bool tet_lanes) {
-              const std::size_t i = index - ch.out;
-              const QualityBounds* mu_given = tet_lanes && want_mu ? lane_of(lane_mu_done, lane_mu, i) : nullptr;
-              const QualityBounds* sj_given = tet_lanes && want_sj ? lane_of(lane_tet_sj_done, lane_tet_sj, i) : nullptr;
-              if ((!want_mu || mu_given) && (!want_sj || sj_given)) {  // nothing needs the nodes
-                qualities(index, nullptr, v, known, mu_given, sj_given);
-                return;
-              }
+                                                   const KnownMargin* known, const QualityBounds* mu_given,
+                                                   const QualityBounds* sj_given) {
               const auto conn = blk.element(element);
               element_nodes.resize(nn * 3);
               for (std::size_t k = 0; k < nn; ++k)
@@ -544,15 +536,34 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             };
             // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp),
             // which never takes the exact fallback: the bookkeeping, and mu and the scaled
-            // Jacobian from the element's nodes (with the chunk's straight-sided margin, if
-            // it has one).
+            // Jacobian from the chunk's lanes or else from the element's nodes (with the
+            // chunk's straight-sided margin, if it has one). Kept small: it runs per element
+            // of every first-order chunk (with `qualities` inlined here, validity of 178k
+            // first-order tetrahedra took 9% longer, and an out-of-line call for the lanes'
+            // results cost mu of 384k 5%).
             const auto finish_first_order = [&](std::size_t index, std::size_t element, const JacobianBounds& b,
                                                 double ticks, const KnownMargin* known, bool tet_lanes) {
               ElementCheck& ec = elements[index];
               ec.bounds = b;
               ec.analysed = true;
               st.add(b.stage, b.validity, ticks);
-              if (want_mu || want_sj) first_order_qualities(index, element, b.validity, known, tet_lanes);
+              if (!want_mu && !want_sj) return;
+              const std::size_t i = index - ch.out;
+              const QualityBounds* mu_given = tet_lanes && want_mu ? lane_of(lane_mu_done, lane_mu, i) : nullptr;
+              const QualityBounds* sj_given = tet_lanes && want_sj ? lane_of(lane_tet_sj_done, lane_tet_sj, i) : nullptr;
+              if ((want_mu && !mu_given) || (want_sj && !sj_given)) {
+                first_order_qualities(index, element, b.validity, known, mu_given, sj_given);
+                return;
+              }
+              // Both from the lanes, whose results always meet the tolerance.
+              if (mu_given) {
+                mu[index] = *mu_given;
+                ++st.mu.computed;
+              }
+              if (sj_given) {
+                sj[index] = *sj_given;
+                ++st.sj.computed;
+              }
             };
             if (fast != LinearKind::none) {
               // First-order fast path (linear_jacobian.hpp): the coefficients straight from
