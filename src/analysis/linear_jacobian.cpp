@@ -351,17 +351,17 @@ double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double
   return next_up(err);
 }
 
-quadval::Lanes<kNativeLanes> linear_tet_jacobian_lanes(const quadval::Lanes<kNativeLanes>* edges,
-                                                       quadval::Lanes<kNativeLanes>& j) noexcept {
-  // Vertex 0 at the origin: each edge x_{c+1} - 0 is exactly the given one.
+quadval::Lanes<kNativeLanes> linear_simplex_jacobian_lanes(LinearKind kind, const quadval::Lanes<kNativeLanes>* edges,
+                                                           quadval::Lanes<kNativeLanes>& j) noexcept {
   using V = quadval::Lanes<kNativeLanes>;  // the chunks' lanes: one type
+  // Vertex 0 at the origin: each edge x_{c+1} - 0 is exactly the given one.
   const auto point = [edges](int v) {
     if (v == 0) return Vec3<V>{};
     const V* e = edges + 3 * (v - 1);
     return Vec3<V>{e[0], e[1], e[2]};
   };
   // A finite err is a positive normal number (error_of), whose next_up is bits + 1.
-  return next_up_nonzero(tet_coefficients(point, &j));
+  return next_up_nonzero(kind == LinearKind::triangle ? triangle_coefficients(point, &j) : tet_coefficients(point, &j));
 }
 
 void linear_validity_chunk(LinearKind kind, const double* soa, std::size_t count,

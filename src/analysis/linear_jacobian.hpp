@@ -95,13 +95,14 @@ inline constexpr std::size_t kLinearRow = kLinearChunk + 8;
 ///         range where the bound holds (then the coefficients are not to be used)
 double linear_jacobian_coefficients(LinearKind kind, const double* nodes, double* coeffs) noexcept;
 
-/// J's coefficient of kNativeLanes tetrahedra from their edges (edges[3 c + j]: coordinate j
-/// of x_{c+1} - x_0, computed from the nodes), lane by lane:
-/// linear_jacobian_coefficients(LinearKind::tetrahedron, ...) of each element alone, the same
+/// J's coefficient of kNativeLanes tetrahedra or triangles (kind) from their edges
+/// (edges[3 c + j]: coordinate j of x_{c+1} - x_0, computed from the nodes; c < 3 or 2),
+/// lane by lane: linear_jacobian_coefficients(kind, ...) of each element alone, the same
 /// bits wherever that returns a finite err (elsewhere err is +inf or NaN).
 /// @param j out: the coefficients
 /// @return the error bounds
-Lanes<kNativeLanes> linear_tet_jacobian_lanes(const Lanes<kNativeLanes>* edges, Lanes<kNativeLanes>& j) noexcept;
+Lanes<kNativeLanes> linear_simplex_jacobian_lanes(LinearKind kind, const Lanes<kNativeLanes>* edges,
+                                                  Lanes<kNativeLanes>& j) noexcept;
 
 /// The fast validity check of a chunk of first-order elements.
 /// @param soa     coordinates by vertex, axis, element: soa[(v * 3 + axis) * row + e],

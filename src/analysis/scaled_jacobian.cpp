@@ -552,7 +552,7 @@ struct StraightSj {
 // linear_jacobian's err. The minimum over the frames of each bound bounds min sj. Not ok
 // where the bounds are wider than tol (or a step below fails).
 // T = double for one element, LaneBlock for one element per lane: the same operations, so
-// the same bits (straight_tet_sj_lanes).
+// the same bits (straight_simplex_sj_lanes).
 template <class T>
 StraightSj<T> straight_simplex_sj(const ScaledJacobianSpace& space, const std::array<std::array<T, 3>, 3>& a,
                                   const std::array<T, 3>& beta, T m, T j1, T err, double tol) {
@@ -632,13 +632,15 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
 
 void scaled_jacobian_use_straight_path(bool on) noexcept { use_straight_path = on; }
 
-unsigned straight_tet_sj_lanes(const ElementType& type, const LaneBlock* edges, const LaneBlock* beta,
-                               LaneBlock margin, double tol, QualityBounds* out) {
-  if (!use_straight_path || type.family != ElementFamily::tetrahedron) return 0;
+unsigned straight_simplex_sj_lanes(const ElementType& type, const LaneBlock* edges, const LaneBlock* beta,
+                                   LaneBlock margin, double tol, QualityBounds* out) {
+  const bool triangle = type.family == ElementFamily::triangle;
+  if (!use_straight_path || !(triangle || type.family == ElementFamily::tetrahedron)) return 0;
   LaneBlock j1;
-  const LaneBlock err = linear_tet_jacobian_lanes(edges, j1);
-  std::array<std::array<LaneBlock, 3>, 3> a;
-  for (std::size_t c = 0; c < 3; ++c)
+  const LaneBlock err =
+      linear_simplex_jacobian_lanes(triangle ? LinearKind::triangle : LinearKind::tetrahedron, edges, j1);
+  std::array<std::array<LaneBlock, 3>, 3> a{};
+  for (std::size_t c = 0; c < static_cast<std::size_t>(type.dim); ++c)
     for (std::size_t j = 0; j < 3; ++j) a[c][j] = edges[3 * c + j];
   // A first-order element's margins are 0, as the element alone takes them.
   const StraightSj<LaneBlock> sj =

@@ -130,13 +130,14 @@ unsigned scaled_jacobian_valid_planar4(const ElementType& type, const std::array
                                        const QualityOptions& options, const std::array<const KnownMargin*, 4>& known,
                                        std::array<QualityBounds, 4>& out);
 
-/// scaled_jacobian_bounds_given of kNativeLanes valid straight-sided tetrahedra of `type` at
-/// once, where the closed form of straight-sided simplices settles them (the same bits):
-/// edges[3 c + j]: coordinate j of x_{c+1} - x_0 per lane (computed from the nodes); beta[c]
-/// and margin: the straight-sided margins of column c and of J that call gets (0 for first
-/// order). Bit l is set where out[l] holds lane l's bounds; the other lanes need the call.
-unsigned straight_tet_sj_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
-                               const Lanes<kNativeLanes>* beta, Lanes<kNativeLanes> margin, double tol,
-                               QualityBounds* out);
+/// scaled_jacobian_bounds_given of kNativeLanes valid straight-sided tetrahedra, or triangles
+/// in a plane z = const, of `type` at once, where the closed form of straight-sided simplices
+/// settles them (the same bits): edges[3 c + j]: coordinate j of x_{c+1} - x_0 per lane
+/// (computed from the nodes; 0 for a triangle's z); beta[c] and margin: the straight-sided
+/// margins of column c and of J that call gets (0 for first order). Bit l is set where
+/// out[l] holds lane l's bounds; the other lanes need the call.
+unsigned straight_simplex_sj_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
+                                   const Lanes<kNativeLanes>* beta, Lanes<kNativeLanes> margin, double tol,
+                                   QualityBounds* out);
 
 }  // namespace quadval

@@ -151,7 +151,7 @@ TEST(StraightTetMu, CheckChunksMatchMuBoundsBitForBit) {
 }
 
 // The same for the scaled Jacobian: the check's chunks take the closed form of
-// straight-sided simplices four tetrahedra at a time (straight_tet_sj_lanes), bit for bit
+// straight-sided simplices four tetrahedra at a time (straight_simplex_sj_lanes), bit for bit
 // what scaled_jacobian_bounds gives each element alone.
 TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
   std::mt19937 rng(78);
@@ -179,7 +179,59 @@ TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
   }
 }
 
-// straight_tet_sj_lanes lane by lane: what scaled_jacobian_bounds_given gives the element
+// Triangles of `type` in the plane z = 0.25 at random, as random_tetrahedra: straight-sided
+// (edge nodes off by a rounding-sized deviation in x and y) or curved, some inverted.
+std::vector<std::vector<double>> random_triangles(const ElementType& type, int count, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<std::vector<double>> elements;
+  for (int e = 0; e < count; ++e) {
+    auto a = random_edges(e, rng);
+    const double origin[2] = {u(rng), u(rng)};
+    const double sign = e % 6 == 4 ? -1 : 1;
+    const double deviation = e % 4 == 0 ? 0.0 : e % 4 == 1 ? 1e-13 : e % 4 == 2 ? 1e-9 : 1e-2;
+    std::vector<double> x;
+    for (const RefPoint& p : reference_nodes(type)) {
+      for (std::size_t k = 0; k < 2; ++k) {
+        double v = origin[k];
+        for (std::size_t c = 0; c < 2; ++c) v += sign * p[c] * a[3 * c + k];
+        const bool vertex = x.size() < 9;
+        x.push_back(vertex ? v : v + deviation * std::abs(a[k]) * u(rng));
+      }
+      x.push_back(0.25);
+    }
+    elements.push_back(std::move(x));
+  }
+  return elements;
+}
+
+// The same for planar triangles, whose scaled Jacobian the chunks take in lanes too.
+TEST(StraightTetMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
+  std::mt19937 rng(79);
+  for (const int id : {2, 9, 21}) {
+    const ElementType& type = *find_element_type(id);
+    SCOPED_TRACE(std::string(type.name));
+    const auto elements = random_triangles(type, 1500, rng);
+    CheckOptions o;
+    o.measure = CheckMeasure::scaled_jacobian;
+    o.threads = 2;
+    const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
+    ASSERT_EQ(r.sj.size(), elements.size());
+    QualityOptions q;
+    q.abs_tol = o.quality_abs_tol;
+    int valid = 0;
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      const QualityBounds alone = scaled_jacobian_bounds(type, elements[e], q, true);
+      EXPECT_EQ(r.sj[e].lower, alone.lower) << "element " << e;
+      EXPECT_EQ(r.sj[e].upper, alone.upper) << "element " << e;
+      EXPECT_EQ(r.sj[e].subdivisions, alone.subdivisions) << "element " << e;
+      EXPECT_EQ(r.sj[e].tolerance_met, alone.tolerance_met) << "element " << e;
+      if (alone.lower > 0) ++valid;
+    }
+    EXPECT_GT(valid, 700);
+  }
+}
+
+// straight_simplex_sj_lanes lane by lane: what scaled_jacobian_bounds_given gives the element
 // alone (with the same margins), whatever its neighbours; a lane whose margin is infinite, or
 // whose closed form misses the tolerance, is left to that call. The closed form of a
 // straight tetrahedron is the scaled Jacobian's exact value up to rounding: sj of the
@@ -203,7 +255,7 @@ TEST(StraightTetMu, ScaledJacobianLanesAreEachElementsOwnBounds) {
       if (block % 9 == 4 && l == 1) margin[l] = INFINITY;
     }
     std::array<QualityBounds, kW> out{};
-    const unsigned done = straight_tet_sj_lanes(type, a, beta, margin, q.abs_tol, out.data());
+    const unsigned done = straight_simplex_sj_lanes(type, a, beta, margin, q.abs_tol, out.data());
     for (int l = 0; l < kW; ++l) {
       const auto& xl = x[static_cast<std::size_t>(l)];
       if (!std::isfinite(margin[l])) {
@@ -230,7 +282,7 @@ TEST(StraightTetMu, ScaledJacobianLanesAreEachElementsOwnBounds) {
   for (int l = 0; l < kW; ++l)
     for (int v = 0; v < 9; ++v) a[v][l] = std::ldexp(regular[v], 10 * l - 15);
   std::array<QualityBounds, kW> out{};
-  ASSERT_EQ(straight_tet_sj_lanes(type, a, beta, margin, 1e-2, out.data()), (1u << kW) - 1);
+  ASSERT_EQ(straight_simplex_sj_lanes(type, a, beta, margin, 1e-2, out.data()), (1u << kW) - 1);
   for (const QualityBounds& b : out) {
     EXPECT_LE(b.lower, 1.0);
     EXPECT_GE(b.upper, 1.0);
