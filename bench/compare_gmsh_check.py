@@ -85,13 +85,8 @@ def hex_box(n, amp=0.2, seed=3):
     return path
 
 
-def curved_plate(spec):
-    """The --plate mesh of spec "tri:H" or "quad:H" (see the top), cached."""
-    kind, h = spec.split(":")
-    h = float(h)
-    if kind not in ("tri", "quad") or not h > 0:
-        raise SystemExit("--plate wants tri:H or quad:H with H > 0, not %r" % spec)
-    path = os.path.join(CACHE, "plate_%s_h%g.msh" % (kind, h))
+def gmsh_cached(path, build):
+    """path, made first (unless cached) by build(gmsh), which meshes the model; then written."""
     if os.path.exists(path):
         return path
     import gmsh
@@ -99,6 +94,21 @@ def curved_plate(spec):
     gmsh.initialize()
     try:
         gmsh.option.setNumber("General.Terminal", 0)
+        build(gmsh)
+        gmsh.write(path)
+    finally:
+        gmsh.finalize()
+    return path
+
+
+def curved_plate(spec):
+    """The --plate mesh of spec "tri:H" or "quad:H" (see the top), cached."""
+    kind, h = spec.split(":")
+    h = float(h)
+    if kind not in ("tri", "quad") or not h > 0:
+        raise SystemExit("--plate wants tri:H or quad:H with H > 0, not %r" % spec)
+
+    def build(gmsh):
         occ = gmsh.model.occ
         plate = occ.addRectangle(0, 0, 0, 10, 6)
         holes = [occ.addDisk(3, 3, 0, 1.5, 0.7), occ.addDisk(7, 3, 0, 1.2, 0.5)]
@@ -117,33 +127,23 @@ def curved_plate(spec):
         xyz[:, 1] += 0.35 * h * np.cos(6 * x) * np.sin(4 * y)
         for t, p in zip(tags, xyz):
             gmsh.model.mesh.setNode(int(t), list(p), [])
-        gmsh.write(path)
-    finally:
-        gmsh.finalize()
-    return path
+
+    return gmsh_cached(os.path.join(CACHE, "plate_%s_h%g.msh" % (kind, h)), build)
 
 
 def tet_box(h):
     """The --tet-box mesh: Gmsh's first-order tetrahedra of the unit cube at size h, cached."""
     if not h > 0:
         raise SystemExit("--tet-box wants a size H > 0, not %r" % h)
-    path = os.path.join(CACHE, "tet_box_h%g.msh" % h)
-    if os.path.exists(path):
-        return path
-    import gmsh
-    os.makedirs(CACHE, exist_ok=True)
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
+
+    def build(gmsh):
         gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
         gmsh.model.occ.synchronize()
         gmsh.option.setNumber("Mesh.MeshSizeMax", h)
         gmsh.model.mesh.generate(3)
         gmsh.option.setNumber("Mesh.Binary", 1)
-        gmsh.write(path)
-    finally:
-        gmsh.finalize()
-    return path
+
+    return gmsh_cached(os.path.join(CACHE, "tet_box_h%g.msh" % h), build)
 
 
 def main():

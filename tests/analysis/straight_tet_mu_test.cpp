@@ -122,6 +122,33 @@ std::vector<std::vector<double>> random_tetrahedra(const ElementType& type, int 
   return elements;
 }
 
+// check_mesh of `elements` (all of `type`) for `measure`, on two threads: each element's
+// bounds (of mu or of the scaled Jacobian, as `measure`) bit for bit those `alone` gives
+// it; returns how many of them have a positive lower bound.
+template <class Alone>
+int expect_check_matches_alone(const ElementType& type, const std::vector<std::vector<double>>& elements,
+                               CheckMeasure measure, Alone alone) {
+  CheckOptions o;
+  o.measure = measure;
+  o.threads = 2;
+  const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
+  const std::vector<QualityBounds>& got = measure == CheckMeasure::mu ? r.mu : r.sj;
+  EXPECT_EQ(got.size(), elements.size());
+  if (got.size() != elements.size()) return 0;
+  QualityOptions q;
+  q.abs_tol = o.quality_abs_tol;
+  int positive = 0;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    const QualityBounds own = alone(elements[e], q);
+    EXPECT_EQ(got[e].lower, own.lower) << "element " << e;
+    EXPECT_EQ(got[e].upper, own.upper) << "element " << e;
+    EXPECT_EQ(got[e].subdivisions, own.subdivisions) << "element " << e;
+    EXPECT_EQ(got[e].tolerance_met, own.tolerance_met) << "element " << e;
+    if (own.lower > 0) ++positive;
+  }
+  return positive;
+}
+
 // The check's chunks (mu of the valid straight-sided tetrahedra 8 at a time) give each
 // element exactly what mu_bounds gives it alone, the fallbacks included, for first-order
 // tetrahedra and for quadratic and cubic ones (straight, with a margin, or curved).
@@ -130,22 +157,9 @@ TEST(StraightTetMu, CheckChunksMatchMuBoundsBitForBit) {
   for (const int id : {4, 11, 29}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const auto elements = random_tetrahedra(type, 1500, rng);
-    CheckOptions o;
-    o.measure = CheckMeasure::mu;
-    o.threads = 2;
-    const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
-    ASSERT_EQ(r.mu.size(), elements.size());
-    QualityOptions q;
-    q.abs_tol = o.quality_abs_tol;
-    int valid = 0;
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-      const QualityBounds alone = mu_bounds(type, elements[e], q, false);
-      EXPECT_EQ(r.mu[e].lower, alone.lower) << "element " << e;
-      EXPECT_EQ(r.mu[e].upper, alone.upper) << "element " << e;
-      EXPECT_EQ(r.mu[e].tolerance_met, alone.tolerance_met) << "element " << e;
-      if (alone.lower > 0) ++valid;
-    }
+    const int valid = expect_check_matches_alone(
+        type, random_tetrahedra(type, 1500, rng), CheckMeasure::mu,
+        [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, false); });
     EXPECT_GT(valid, 700);
   }
 }
@@ -158,23 +172,9 @@ TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
   for (const int id : {4, 11, 29}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const auto elements = random_tetrahedra(type, 1500, rng);
-    CheckOptions o;
-    o.measure = CheckMeasure::scaled_jacobian;
-    o.threads = 2;
-    const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
-    ASSERT_EQ(r.sj.size(), elements.size());
-    QualityOptions q;
-    q.abs_tol = o.quality_abs_tol;
-    int valid = 0;
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-      const QualityBounds alone = scaled_jacobian_bounds(type, elements[e], q, false);
-      EXPECT_EQ(r.sj[e].lower, alone.lower) << "element " << e;
-      EXPECT_EQ(r.sj[e].upper, alone.upper) << "element " << e;
-      EXPECT_EQ(r.sj[e].subdivisions, alone.subdivisions) << "element " << e;
-      EXPECT_EQ(r.sj[e].tolerance_met, alone.tolerance_met) << "element " << e;
-      if (alone.lower > 0) ++valid;
-    }
+    const int valid = expect_check_matches_alone(
+        type, random_tetrahedra(type, 1500, rng), CheckMeasure::scaled_jacobian,
+        [&](const std::vector<double>& x, const QualityOptions& q) { return scaled_jacobian_bounds(type, x, q, false); });
     EXPECT_GT(valid, 700);
   }
 }
@@ -210,23 +210,9 @@ TEST(StraightTetMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
   for (const int id : {2, 9, 21}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const auto elements = random_triangles(type, 1500, rng);
-    CheckOptions o;
-    o.measure = CheckMeasure::scaled_jacobian;
-    o.threads = 2;
-    const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
-    ASSERT_EQ(r.sj.size(), elements.size());
-    QualityOptions q;
-    q.abs_tol = o.quality_abs_tol;
-    int valid = 0;
-    for (std::size_t e = 0; e < elements.size(); ++e) {
-      const QualityBounds alone = scaled_jacobian_bounds(type, elements[e], q, true);
-      EXPECT_EQ(r.sj[e].lower, alone.lower) << "element " << e;
-      EXPECT_EQ(r.sj[e].upper, alone.upper) << "element " << e;
-      EXPECT_EQ(r.sj[e].subdivisions, alone.subdivisions) << "element " << e;
-      EXPECT_EQ(r.sj[e].tolerance_met, alone.tolerance_met) << "element " << e;
-      if (alone.lower > 0) ++valid;
-    }
+    const int valid = expect_check_matches_alone(
+        type, random_triangles(type, 1500, rng), CheckMeasure::scaled_jacobian,
+        [&](const std::vector<double>& x, const QualityOptions& q) { return scaled_jacobian_bounds(type, x, q, true); });
     EXPECT_GT(valid, 700);
   }
 }
