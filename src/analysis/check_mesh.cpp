@@ -537,7 +537,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // its nodes, where its chunk's lanes (simplex_lanes_of) did not settle them.
             const auto first_order_qualities = [&](std::size_t index, std::size_t element, Validity v,
                                                    const KnownMargin* known, const QualityBounds* mu_given,
-                                                   const QualityBounds* sj_given) {
+                                                   const QualityBounds* sj_given) __attribute__((noinline)) {
               const auto conn = blk.element(element);
               element_nodes.resize(nn * 3);
               for (std::size_t k = 0; k < nn; ++k)
@@ -548,12 +548,13 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // `finish` for an element decided by the first-order chunk (linear_jacobian.hpp),
             // which never takes the exact fallback: the bookkeeping, and mu and the scaled
             // Jacobian from the chunk's lanes or else from the element's nodes (with the
-            // chunk's straight-sided margin, if it has one). Kept small: it runs per element
-            // of every first-order chunk (with `qualities` inlined here, validity of 178k
-            // first-order tetrahedra took 9% longer, and an out-of-line call for the lanes'
-            // results cost mu of 384k 5%).
+            // chunk's straight-sided margin, if it has one). Inlined and kept small, the rest
+            // out of line: it runs per element of every first-order chunk (with `qualities`
+            // inlined here, validity of 178k first-order tetrahedra took 9% longer; as a call,
+            // mu of 384k took 3-5% longer).
             const auto finish_first_order = [&](std::size_t index, std::size_t element, const JacobianBounds& b,
-                                                double ticks, const KnownMargin* known, bool in_lanes) {
+                                                double ticks, const KnownMargin* known,
+                                                bool in_lanes) __attribute__((always_inline)) {
               ElementCheck& ec = elements[index];
               ec.bounds = b;
               ec.analysed = true;
