@@ -515,9 +515,10 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                       (!betas || std::isfinite(margins[i])))
                     valid |= 1u << l;
                 }
-                lane_mu_done[i0 / kW] = valid != 0 && lane_mu_wanted
-                                            ? valid & straight_tet_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0)
-                                            : 0u;
+                lane_mu_done[i0 / kW] =
+                    valid != 0 && lane_mu_wanted
+                        ? valid & straight_tet_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0)
+                        : 0u;
                 lane_simplex_sj_done[i0 / kW] =
                     valid != 0 && lane_sj_wanted
                         ? valid & straight_simplex_sj_lanes(t, edges, margin, j_margin, qo.abs_tol,
@@ -528,7 +529,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // Whether a chunk of that first-order kind (or straight-sided elements of it) has
             // results in simplex_lanes_of's lanes.
             const auto simplex_lanes_for = [&](LinearKind kind) {
-              return ((want_mu || want_sj) && kind == LinearKind::tetrahedron) || (want_sj && kind == LinearKind::triangle);
+              return ((want_mu || want_sj) && kind == LinearKind::tetrahedron) ||
+                     (want_sj && kind == LinearKind::triangle);
             };
             const auto lane_of = [&](const unsigned* done, std::vector<QualityBounds>& lane, std::size_t i) {
               return ((done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane[i] : nullptr;
@@ -599,7 +601,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
               const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
               const bool simplex_lanes = simplex_lanes_for(fast);
-              if (simplex_lanes) simplex_lanes_of(type, kLinearRow, nullptr, nullptr, ch.count);  // outside the stage times
+              if (simplex_lanes)  // outside the stage times
+                simplex_lanes_of(type, kLinearRow, nullptr, nullptr, ch.count);
               nodes.resize(nn * 3);
               errors.resize(1);
               for (std::size_t i = 0; i < ch.count; ++i) {
@@ -676,7 +679,8 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   std::fill(decided, decided + ch.count, false);  // a chunk of curved elements
                 }
                 const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
-                if (simplex_lanes) simplex_lanes_of(type, kRow, betas.data(), margins.data(), ch.count);  // outside the stage times
+                if (simplex_lanes)  // outside the stage times
+                  simplex_lanes_of(type, kRow, betas.data(), margins.data(), ch.count);
                 for (std::size_t i = 0; i < ch.count; ++i) {
                   if (!decided[i]) {
                     rest[left++] = i;

@@ -860,7 +860,8 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   if (v == Validity::invalid && (dim == 3 || (dim == 2 && !area))) {
     const QuotientInput in = quotient_input(polys, udim);
     const int splits = std::min(kSignedSplits, options.max_subdivisions);
-    quick = signed_quotient_bounds(space, in, options.abs_tol, splits, 0.0, &quick_frames, signed_floor_root_ends(type));
+    quick = signed_quotient_bounds(space, in, options.abs_tol, splits, 0.0, &quick_frames,
+                                   signed_floor_root_ends(type));
     if (quick.tolerance_met) return quick;
     // Not settled, in 2D with the lower bound at the floor -s (a fold: the columns at right
     // angles, the wrong way round): that bound is sharp, and only the upper bound, from the

@@ -174,7 +174,9 @@ TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
     SCOPED_TRACE(std::string(type.name));
     const int valid = expect_check_matches_alone(
         type, random_tetrahedra(type, 1500, rng), CheckMeasure::scaled_jacobian,
-        [&](const std::vector<double>& x, const QualityOptions& q) { return scaled_jacobian_bounds(type, x, q, false); });
+        [&](const std::vector<double>& x, const QualityOptions& q) {
+          return scaled_jacobian_bounds(type, x, q, false);
+        });
     EXPECT_GT(valid, 700);
   }
 }
@@ -212,7 +214,9 @@ TEST(StraightTetMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
     SCOPED_TRACE(std::string(type.name));
     const int valid = expect_check_matches_alone(
         type, random_triangles(type, 1500, rng), CheckMeasure::scaled_jacobian,
-        [&](const std::vector<double>& x, const QualityOptions& q) { return scaled_jacobian_bounds(type, x, q, true); });
+        [&](const std::vector<double>& x, const QualityOptions& q) {
+          return scaled_jacobian_bounds(type, x, q, true);
+        });
     EXPECT_GT(valid, 700);
   }
 }
