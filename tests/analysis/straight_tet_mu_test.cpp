@@ -99,23 +99,29 @@ TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
   EXPECT_GT(ok, total * 3 / 4);  // the rest: nearly degenerate, left to the general path
 }
 
-// Tetrahedra of `type` at random: straight-sided (edge nodes straight, off by a
-// rounding-sized deviation, which gives a margin) or curved, some inverted.
-std::vector<std::vector<double>> random_tetrahedra(const ElementType& type, int count, std::mt19937& rng) {
+// Simplices of `type` at random, tetrahedra or triangles in the plane z = 0.25:
+// straight-sided (edge nodes straight, off by a rounding-sized deviation in the element's
+// coordinates, which gives a margin) or curved, some inverted.
+std::vector<std::vector<double>> random_simplices(const ElementType& type, int count, std::mt19937& rng) {
+  const std::size_t dim = type.dim == 2 ? 2 : 3;
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<std::vector<double>> elements;
   for (int e = 0; e < count; ++e) {
     const auto a = random_edges(e, rng);
-    const double origin[3] = {u(rng), u(rng), u(rng)};
+    double origin[3] = {0, 0, 0.25};
+    for (std::size_t k = 0; k < dim; ++k) origin[k] = u(rng);
     const double sign = e % 6 == 4 ? -1 : 1;
     const double deviation = e % 4 == 0 ? 0.0 : e % 4 == 1 ? 1e-13 : e % 4 == 2 ? 1e-9 : 1e-2;
     std::vector<double> x;
     for (const RefPoint& p : reference_nodes(type))
       for (std::size_t k = 0; k < 3; ++k) {
         double v = origin[k];
-        for (std::size_t c = 0; c < 3; ++c) v += sign * p[c] * a[3 * c + k];
-        const bool vertex = x.size() < 12;
-        x.push_back(vertex ? v : v + deviation * std::abs(a[k]) * u(rng));
+        if (k < dim) {
+          for (std::size_t c = 0; c < dim; ++c) v += sign * p[c] * a[3 * c + k];
+          const bool vertex = x.size() < 3 * (dim + 1);
+          if (!vertex) v += deviation * std::abs(a[k]) * u(rng);
+        }
+        x.push_back(v);
       }
     elements.push_back(std::move(x));
   }
@@ -158,7 +164,7 @@ TEST(StraightTetMu, CheckChunksMatchMuBoundsBitForBit) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
     const int valid = expect_check_matches_alone(
-        type, random_tetrahedra(type, 1500, rng), CheckMeasure::mu,
+        type, random_simplices(type, 1500, rng), CheckMeasure::mu,
         [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, false); });
     EXPECT_GT(valid, 700);
   }
@@ -173,37 +179,12 @@ TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
     const int valid = expect_check_matches_alone(
-        type, random_tetrahedra(type, 1500, rng), CheckMeasure::scaled_jacobian,
+        type, random_simplices(type, 1500, rng), CheckMeasure::scaled_jacobian,
         [&](const std::vector<double>& x, const QualityOptions& q) {
           return scaled_jacobian_bounds(type, x, q, false);
         });
     EXPECT_GT(valid, 700);
   }
-}
-
-// Triangles of `type` in the plane z = 0.25 at random, as random_tetrahedra: straight-sided
-// (edge nodes off by a rounding-sized deviation in x and y) or curved, some inverted.
-std::vector<std::vector<double>> random_triangles(const ElementType& type, int count, std::mt19937& rng) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<std::vector<double>> elements;
-  for (int e = 0; e < count; ++e) {
-    auto a = random_edges(e, rng);
-    const double origin[2] = {u(rng), u(rng)};
-    const double sign = e % 6 == 4 ? -1 : 1;
-    const double deviation = e % 4 == 0 ? 0.0 : e % 4 == 1 ? 1e-13 : e % 4 == 2 ? 1e-9 : 1e-2;
-    std::vector<double> x;
-    for (const RefPoint& p : reference_nodes(type)) {
-      for (std::size_t k = 0; k < 2; ++k) {
-        double v = origin[k];
-        for (std::size_t c = 0; c < 2; ++c) v += sign * p[c] * a[3 * c + k];
-        const bool vertex = x.size() < 9;
-        x.push_back(vertex ? v : v + deviation * std::abs(a[k]) * u(rng));
-      }
-      x.push_back(0.25);
-    }
-    elements.push_back(std::move(x));
-  }
-  return elements;
 }
 
 // The same for planar triangles, whose scaled Jacobian the chunks take in lanes too.
@@ -213,7 +194,7 @@ TEST(StraightTetMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
     const int valid = expect_check_matches_alone(
-        type, random_triangles(type, 1500, rng), CheckMeasure::scaled_jacobian,
+        type, random_simplices(type, 1500, rng), CheckMeasure::scaled_jacobian,
         [&](const std::vector<double>& x, const QualityOptions& q) {
           return scaled_jacobian_bounds(type, x, q, true);
         });
