@@ -34,7 +34,7 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/stage_clock.hpp"
-#include "analysis/straight_tet_mu.hpp"
+#include "analysis/straight_simplex_mu.hpp"
 #include "analysis/worker_threads.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/error.hpp"
@@ -483,19 +483,19 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
-            // mu and the scaled Jacobian of a chunk's valid straight-sided tetrahedra, and the
-            // scaled Jacobian of its planar straight-sided triangles (decided by
+            // mu and the scaled Jacobian of a chunk's valid straight-sided tetrahedra and
+            // planar triangles (decided by
             // linear_validity_chunk, vertices in `soa` by vertex and axis, rows of `row`, z
             // not read for triangles; betas and js: the straight-sided margins of the columns,
             // 3 per element, and of J, or none for first-order ones), W = kNativeLanes at a
-            // time (straight_tet_mu.hpp, straight_simplex_sj_lanes): bit i % W of
+            // time (straight_simplex_mu.hpp, straight_simplex_sj_lanes): bit i % W of
             // lane_mu_done[i / W] set where lane_mu[i] holds element i's mu as mu_bounds_given
             // would compute it, likewise lane_simplex_sj_done and lane_simplex_sj for the
             // scaled Jacobian.
             const auto simplex_lanes_of = [&](const ElementType& t, std::size_t row, const double* betas,
                                               const double* js, std::size_t count) {
               const bool tet = t.family == ElementFamily::tetrahedron;
-              const bool lane_mu_wanted = want_mu && tet && mu_supported(t);
+              const bool lane_mu_wanted = want_mu && mu_supported(t);
               const bool lane_sj_wanted = want_sj && scaled_jacobian_supported(t);
               const std::size_t edge_values = tet ? 9 : 6;  // 3 or 2 edges, x y z each
               lane_mu.resize(kLinearChunk);
@@ -517,7 +517,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                 }
                 lane_mu_done[i0 / kW] =
                     valid != 0 && lane_mu_wanted
-                        ? valid & straight_tet_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0)
+                        ? valid & straight_simplex_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0)
                         : 0u;
                 lane_simplex_sj_done[i0 / kW] =
                     valid != 0 && lane_sj_wanted
@@ -529,8 +529,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // Whether a chunk of that first-order kind (or straight-sided elements of it) has
             // results in simplex_lanes_of's lanes.
             const auto simplex_lanes_for = [&](LinearKind kind) {
-              return ((want_mu || want_sj) && kind == LinearKind::tetrahedron) ||
-                     (want_sj && kind == LinearKind::triangle);
+              return (want_mu || want_sj) && (kind == LinearKind::tetrahedron || kind == LinearKind::triangle);
             };
             const auto lane_of = [&](const unsigned* done, std::vector<QualityBounds>& lane, std::size_t i) {
               return ((done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane[i] : nullptr;

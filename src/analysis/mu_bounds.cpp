@@ -24,7 +24,7 @@
 #include "analysis/outward_rounding.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
-#include "analysis/straight_tet_mu.hpp"
+#include "analysis/straight_simplex_mu.hpp"
 #include "analysis/symmetric3_lanes.hpp"
 #include "analysis/trilinear_hex_mu.hpp"
 #include "bezier/bernstein_bisection.hpp"
@@ -146,18 +146,19 @@ std::optional<QualityBounds> straight_simplex_mu(const MuSpace& space, std::span
   if (!simplex) return std::nullopt;
   std::array<double, 3> beta{0, 0, 0};
   if (type.order > 1 && !(straight_margin_of(type, x.data(), known, beta) < kInf)) return std::nullopt;
-  if (type.family == ElementFamily::tetrahedron) {
-    // The closed form in lanes (straight_tet_mu.hpp), the element in both: the same bounds
-    // as the check's chunks of eight; where it fails, the general closed form below.
-    Lanes<2> edges[9], margins[3];
-    for (std::size_t c = 0; c < 3; ++c) {
+  const auto dim = static_cast<std::size_t>(type.dim);
+  {
+    // The closed form in lanes (straight_simplex_mu.hpp), the element in both: the same
+    // bounds as the check's chunks; where it fails, the general closed form below.
+    Lanes<2> edges[9] = {}, margins[3] = {};
+    for (std::size_t c = 0; c < dim; ++c) {
       margins[c] = broadcast_lanes<2>(beta[c]);
       for (std::size_t j = 0; j < 3; ++j) edges[3 * c + j] = broadcast_lanes<2>(x[3 * (c + 1) + j] - x[j]);
     }
-    const StraightTetRatio<2> r = straight_tet_ratio<2>(edges, margins, space.ideal_inverse());
+    const StraightSimplexRatio<2> r = dim == 3 ? straight_tet_ratio<2>(edges, margins, space.ideal_inverse())
+                                               : straight_triangle_ratio<2>(edges, margins, space.ideal_inverse());
     if ((r.ok & 1u) != 0) return mu_from_ratio(r.lower[0], r.upper[0], tol);
   }
-  const auto dim = static_cast<std::size_t>(type.dim);
   double a[3][3] = {}, a_max[3] = {0, 0, 0};
   for (std::size_t c = 0; c < dim; ++c)
     for (std::size_t j = 0; j < 3; ++j) {
@@ -213,11 +214,13 @@ std::optional<QualityBounds> refined_hex_mu(std::span<const double> nodes, const
 
 void mu_use_control_bound(int mode) noexcept { control_mode = mode; }
 
-unsigned straight_tet_mu_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
-                               const Lanes<kNativeLanes>* margins, double tol, QualityBounds* out) {
+unsigned straight_simplex_mu_lanes(const ElementType& type, const Lanes<kNativeLanes>* edges,
+                                   const Lanes<kNativeLanes>* margins, double tol, QualityBounds* out) {
   if (!mu_constant_path_enabled()) return 0;
-  const StraightTetRatio<kNativeLanes> r =
-      straight_tet_ratio<kNativeLanes>(edges, margins, mu_space(type).ideal_inverse());
+  const std::array<double, 9>& jinv = mu_space(type).ideal_inverse();
+  const StraightSimplexRatio<kNativeLanes> r = type.family == ElementFamily::tetrahedron
+                                                   ? straight_tet_ratio<kNativeLanes>(edges, margins, jinv)
+                                                   : straight_triangle_ratio<kNativeLanes>(edges, margins, jinv);
   unsigned done = 0;
   for (int l = 0; l < kNativeLanes; ++l)
     if ((r.ok >> l) & 1u)
@@ -518,7 +521,7 @@ unsigned planar_mu_roots(const MuSpace& space, const std::array<std::span<const 
       cm[e] = sum;
       cerr = vmax(cerr, (prop + rounding_gamma(4) * mag) * (1 + 1e-12));
     }
-    const V closed = enclosure_ratio_upper2_lanes(cm, cerr);
+    const V closed = enclosure_ratio_upper2_lanes<4>(cm, cerr);
     open &= ~lanes3::mask_bits<4>(closed < 1e-2);
     r_upper = vmin(r_upper, closed);
   }

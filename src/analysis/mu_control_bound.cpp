@@ -196,26 +196,38 @@ template <int W>
   const V ratio = down<W>(min_lo / max_hi);
   return known ? vmin(vmax(ratio, zero), V{} + 1) : zero;
 }
+template Lanes<2> enclosure_ratio_lower2_lanes<2>(const Lanes<2>*, Lanes<2>);
 template Lanes<4> enclosure_ratio_lower2_lanes<4>(const Lanes<4>*, Lanes<4>);
+#if defined(__AVX512F__)  // kNativeLanes
+template Lanes<8> enclosure_ratio_lower2_lanes<8>(const Lanes<8>*, Lanes<8>);
+#endif
 
-Lanes<4> enclosure_ratio_upper2_lanes(const Lanes<4>* m, Lanes<4> err) {
+template <int W>
+Lanes<W> enclosure_ratio_upper2_lanes(const Lanes<W>* m, Lanes<W> err) {
   using lanes3::down;
   using lanes3::up;
-  using V = Lanes<4>;
+  using V = Lanes<W>;
   const V zero{}, q = 0.5 * (m[0] + m[1]), s = 0.5 * (m[0] - m[1]), t = m[2];
   const V rq = (err + kGamma * 0.5 * (vabs(m[0]) + vabs(m[1]))) * (1 + kGamma);
-  const V s_hi = up<4>(vabs(s) + rq), s_lo = vmax(zero, down<4>(vabs(s) - rq));
-  const V t_hi = up<4>(vabs(t) + err), t_lo = vmax(zero, down<4>(vabs(t) - err));
-  const V d_hi = up<4>(lanes3::root<4>(up<4>(up<4>(s_hi * s_hi) + up<4>(t_hi * t_hi))));
-  const V d_lo = vmax(zero, down<4>(lanes3::root<4>(vmax(zero, down<4>(down<4>(s_lo * s_lo) + down<4>(t_lo * t_lo))))));
-  const V q_lo = down<4>(q - rq), q_hi = up<4>(q + rq);
+  const V s_hi = up<W>(vabs(s) + rq), s_lo = vmax(zero, down<W>(vabs(s) - rq));
+  const V t_hi = up<W>(vabs(t) + err), t_lo = vmax(zero, down<W>(vabs(t) - err));
+  const V d_hi = up<W>(lanes3::root<W>(up<W>(up<W>(s_hi * s_hi) + up<W>(t_hi * t_hi))));
+  const V d_lo = vmax(zero, down<W>(lanes3::root<W>(vmax(zero, down<W>(down<W>(s_lo * s_lo) + down<W>(t_lo * t_lo))))));
+  const V q_lo = down<W>(q - rq), q_hi = up<W>(q + rq);
   constexpr double kMax = std::numeric_limits<double>::max();
   const auto known = (vabs(q_lo) <= kMax) & (vabs(q_hi) <= kMax) & (vabs(d_hi) <= kMax);
-  const V min_hi = up<4>(q_hi - d_lo), max_lo = down<4>(q_lo + d_lo);
+  const V min_hi = up<W>(q_hi - d_lo), max_lo = down<W>(q_lo + d_lo);
   // ratio_upper: 1 where unknown, max_lo not positive or min_hi not finite, else clamped.
-  const V ratio = vmin(vmax(up<4>(min_hi / max_lo), zero), V{} + 1);
+  const V ratio = vmin(vmax(up<W>(min_hi / max_lo), zero), V{} + 1);
   return known & (max_lo > 0) & (min_hi < kInf) ? ratio : V{} + 1;
 }
+// Four lanes: mu_bounds.cpp; two and the native width: the closed form of straight triangles
+// (straight_simplex_mu.cpp).
+template Lanes<2> enclosure_ratio_upper2_lanes<2>(const Lanes<2>*, Lanes<2>);
+template Lanes<4> enclosure_ratio_upper2_lanes<4>(const Lanes<4>*, Lanes<4>);
+#if defined(__AVX512F__)  // kNativeLanes
+template Lanes<8> enclosure_ratio_upper2_lanes<8>(const Lanes<8>*, Lanes<8>);
+#endif
 
 namespace {
 

@@ -115,8 +115,9 @@ double control_ratio_lower(const double* const* entries, const double* err, int 
 template <int W>
 Lanes<W> enclosure_ratio_lower2_lanes(const Lanes<W>* m, Lanes<W> err);
 
-/// symmetric_eigen_enclosure<2>(m_l, err_l).ratio_upper() of four matrices at once, matrix
+/// symmetric_eigen_enclosure<2>(m_l, err_l).ratio_upper() of W matrices at once, matrix
 /// l in lane l: the same bits lane by lane.
-Lanes<4> enclosure_ratio_upper2_lanes(const Lanes<4>* m, Lanes<4> err);
+template <int W>
+Lanes<W> enclosure_ratio_upper2_lanes(const Lanes<W>* m, Lanes<W> err);
 
 }  // namespace quadval

@@ -26,7 +26,7 @@ list(APPEND QUADVAL_SOURCES
   src/analysis/mu_space.cpp
   src/analysis/mu_metric.cpp
   src/analysis/mu_constant.cpp
-  src/analysis/straight_tet_mu.cpp
+  src/analysis/straight_simplex_mu.cpp
   src/analysis/vertex_metric_ratio.cpp
   src/analysis/trilinear_hex_mu.cpp
   src/analysis/linear_pyramid_mu.cpp

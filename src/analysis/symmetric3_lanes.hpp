@@ -2,7 +2,7 @@
 // Certified eigenvalue steps on symmetric 3 x 3 matrices, several matrices at once in SIMD
 // lanes (lane_vector.hpp: each lane computes exactly what the scalar functions of
 // mu_control_bound.cpp and mu_metric.cpp compute for one matrix). Shared by the closed form
-// of straight-sided tetrahedra (straight_tet_mu.hpp, lanes over elements) and the control
+// of straight-sided tetrahedra (straight_simplex_mu.hpp, lanes over elements) and the control
 // matrices of first-order hexahedra (trilinear_hex_mu.hpp, lanes over control points).
 // Internal to src/analysis.
 //

@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "analysis/lane_vector.hpp"
-#include "analysis/straight_tet_mu.hpp"
+#include "analysis/straight_simplex_mu.hpp"
 #include "analysis/symmetric3_lanes.hpp"
 #include "quadval/error.hpp"
 
@@ -136,7 +136,7 @@ CertifiedRatio columns_ratio(const VertexProducts& domain, const double (*col)[8
     for (int k = 0; k < 3; ++k) edges[3 * c + k] = broadcast_lanes<2>(col[c][0][k]);
   }
   if (spread <= 1e-9 * scale) {
-    const StraightTetRatio<2> r = straight_tet_ratio<2>(edges, margins, jinv);
+    const StraightSimplexRatio<2> r = straight_tet_ratio<2>(edges, margins, jinv);
     if ((r.ok & 1u) != 0) return {r.lower[0], r.upper[0], r.lower[0] <= r.upper[0]};
   }
   double w[3][8][3] = {};

@@ -91,7 +91,7 @@ CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], i
 /// R's bounds for W = J Jinv (any common scale of J), from J's columns' control values at
 /// the vertices, col[c][q][k], each entry within rounding[c] of the exact one. Where the
 /// columns agree at every vertex to 1e-9 (W constant: a pyramid's parallelogram base, a
-/// prism's translated top), the closed form of straight_tet_mu.hpp with each column's
+/// prism's translated top), the closed form of straight_simplex_mu.hpp with each column's
 /// spread as its margin; else W's control values (a sum of 3 products per entry, within
 /// sum_c |Jinv_cj| (rounding[c] + 4u |col_c|)) go to vertex_metric_ratio.
 CertifiedRatio columns_ratio(const VertexProducts& domain, const double (*col)[8][3], const double* rounding,

@@ -177,7 +177,7 @@ TEST(MuControlBound, EnclosureRatiosInLanesAreTheScalarBits) {
       err[l] = std::abs(u(rng)) * 1e-12 * m[0][l];
     }
     if (trial == 7) m[0][2] = std::numeric_limits<double>::infinity();
-    const Lanes<4> lo = enclosure_ratio_lower2_lanes<4>(m, err), hi = enclosure_ratio_upper2_lanes(m, err);
+    const Lanes<4> lo = enclosure_ratio_lower2_lanes<4>(m, err), hi = enclosure_ratio_upper2_lanes<4>(m, err);
     for (int l = 0; l < 4; ++l) {
       const double ml[3] = {m[0][l], m[1][l], m[2][l]};
       const EigenEnclosure e = symmetric_eigen_enclosure<2>(ml, err[l]);

@@ -1,8 +1,8 @@
-// The lane-parallel closed form of mu for straight-sided tetrahedra
-// (src/analysis/straight_tet_mu.hpp): against the singular values of W in long double
+// The lane-parallel closed form of mu for straight-sided tetrahedra and planar triangles
+// (src/analysis/straight_simplex_mu.hpp): against the singular values of W in long double
 // (an oracle sharing no code with it), lane by lane the same whatever the lane, and in the
-// check (8 elements at a time) bit for bit what mu_bounds gives each element alone; and the
-// scaled Jacobian's closed form of straight-sided tetrahedra in lanes, likewise.
+// check (kNativeLanes elements at a time) bit for bit what mu_bounds gives each element
+// alone; and the scaled Jacobian's closed form of straight-sided simplices in lanes, likewise.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -12,7 +12,7 @@
 #include "analysis/lane_vector.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
-#include "analysis/straight_tet_mu.hpp"
+#include "analysis/straight_simplex_mu.hpp"
 #include "jacobian_test_util.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/element_type.hpp"
@@ -38,6 +38,20 @@ long double exact_ratio(const double* edges, const std::array<double, 9>& jinv) 
   return (s(2) / s(0)) * (s(2) / s(0));
 }
 
+// R of a triangle in a plane z = const: W = [edges] Jinv is 3 x 2 (the z row zero), its
+// two singular values in long double.
+long double exact_triangle_ratio(const double* edges, const std::array<double, 9>& jinv) {
+  Eigen::Matrix<long double, 3, 2> a;
+  Eigen::Matrix<long double, 2, 2> j;
+  for (int c = 0; c < 2; ++c) {
+    for (int k = 0; k < 3; ++k) a(k, c) = edges[3 * c + k];
+    for (int k = 0; k < 2; ++k) j(c, k) = jinv[static_cast<std::size_t>(c * 3 + k)];
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix<long double, 3, 2>> svd(a * j);
+  const auto s = svd.singularValues();
+  return (s(1) / s(0)) * (s(1) / s(0));
+}
+
 // Edges of a random tetrahedron: well shaped, stretched, nearly flat or with a nearly
 // vanishing edge, at scales from 1e-9 to 1e6.
 std::array<double, 9> random_edges(int e, std::mt19937& rng) {
@@ -55,7 +69,7 @@ std::array<double, 9> random_edges(int e, std::mt19937& rng) {
   return a;
 }
 
-TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
+TEST(StraightSimplexMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
   std::mt19937 rng(5150);
   const std::array<double, 9>& jinv = mu_space(*find_element_type(4)).ideal_inverse();
   constexpr int kW = kNativeLanes;  // the width the checks run at
@@ -71,7 +85,7 @@ TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
       for (int v = 0; v < 9; ++v) a[v][l] = edges[static_cast<std::size_t>(l)][static_cast<std::size_t>(v)];
       for (int c = 0; c < 3; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
     }
-    const StraightTetRatio<kW> r = straight_tet_ratio<kW>(a, beta, jinv);
+    const StraightSimplexRatio<kW> r = straight_tet_ratio<kW>(a, beta, jinv);
     for (int l = 0; l < kW; ++l) {
       ++total;
       const auto& x = edges[static_cast<std::size_t>(l)];
@@ -79,7 +93,7 @@ TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
       Lanes<2> a2[9], b2[3];
       for (int v = 0; v < 9; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
       for (int c = 0; c < 3; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
-      const StraightTetRatio<2> alone = straight_tet_ratio<2>(a2, b2, jinv);
+      const StraightSimplexRatio<2> alone = straight_tet_ratio<2>(a2, b2, jinv);
       ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * kW + l;
       if (((r.ok >> l) & 1u) == 0) continue;
       ++ok;
@@ -97,6 +111,76 @@ TEST(StraightTetMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
     }
   }
   EXPECT_GT(ok, total * 3 / 4);  // the rest: nearly degenerate, left to the general path
+}
+
+// The same for triangles: edges 0 and 1 of random_edges in the plane (z differences 0).
+TEST(StraightSimplexMu, TriangleLanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
+  std::mt19937 rng(5152);
+  const std::array<double, 9>& jinv = mu_space(*find_element_type(2)).ideal_inverse();
+  constexpr int kW = kNativeLanes;
+  int ok = 0, total = 0;
+  for (int block = 0; block < 400; ++block) {
+    std::array<std::array<double, 9>, kW> edges;
+    std::array<double, kW> margin{};
+    Lanes<kW> a[9] = {}, beta[3] = {};
+    for (int l = 0; l < kW; ++l) {
+      auto& x = edges[static_cast<std::size_t>(l)];
+      x = random_edges(block * kW + l, rng);
+      x[2] = x[5] = x[6] = x[7] = x[8] = 0;
+      if ((block * kW + l) % 5 == 1)  // nearly flat: edge 1 close to a multiple of edge 0
+        for (std::size_t k = 0; k < 2; ++k) x[3 + k] = 0.7 * x[k] + 1e-5 * std::abs(x[0]) * (k == 0 ? 1 : -1);
+      margin[static_cast<std::size_t>(l)] = block % 2 == 0 ? 0.0 : 1e-9 * std::abs(x[0]);
+      for (int v = 0; v < 6; ++v) a[v][l] = x[static_cast<std::size_t>(v)];
+      for (int c = 0; c < 2; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
+    }
+    const StraightSimplexRatio<kW> r = straight_triangle_ratio<kW>(a, beta, jinv);
+    for (int l = 0; l < kW; ++l) {
+      ++total;
+      const auto& x = edges[static_cast<std::size_t>(l)];
+      Lanes<2> a2[9] = {}, b2[3] = {};
+      for (int v = 0; v < 6; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
+      for (int c = 0; c < 2; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
+      const StraightSimplexRatio<2> alone = straight_triangle_ratio<2>(a2, b2, jinv);
+      ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * kW + l;
+      if (((r.ok >> l) & 1u) == 0) continue;
+      ++ok;
+      EXPECT_EQ(r.lower[l], alone.lower[0]);
+      EXPECT_EQ(r.upper[l], alone.upper[0]);
+      const long double exact = exact_triangle_ratio(x.data(), jinv);
+      EXPECT_LE(r.lower[l], exact * (1 + 1e-15L)) << "element " << block * kW + l;
+      EXPECT_GE(r.upper[l], exact * (1 - 1e-15L)) << "element " << block * kW + l;
+      EXPECT_LE(r.lower[l], r.upper[l]);
+      const double gap = margin[static_cast<std::size_t>(l)] == 0 ? 1e-7 : 1e-4;
+      if (exact > 1e-3L) {
+        EXPECT_LE(r.upper[l] - r.lower[l], gap * static_cast<double>(exact)) << "element " << block * kW + l;
+      }
+    }
+  }
+  EXPECT_GT(ok, total * 3 / 4);
+  // Closed forms, each at scales 2^-15 .. 2^15: the equilateral triangle R = 1; stretched
+  // by 3 along x, R = 1/9 (the ratio of its stretches, squared); the right isosceles one
+  // with legs along the axes, W = Jinv = [1, -1/sqrt 3; 0, 2/sqrt 3], W^T W with
+  // eigenvalues 2 and 2/3, R = 1/3.
+  const double h = std::sqrt(3.0) / 2;
+  const std::array<std::pair<std::array<double, 4>, double>, 3> cases{{
+      {{1, 0, 0.5, h}, 1.0}, {{3, 0, 1.5, h}, 1.0 / 9}, {{1, 0, 0, 1}, 1.0 / 3}}};
+  for (const auto& [e, exact] : cases) {
+    Lanes<kW> a[9] = {}, beta[3] = {};
+    for (int l = 0; l < kW; ++l) {
+      const double scale = std::ldexp(1.0, 10 * l - 15);
+      a[0][l] = e[0] * scale;
+      a[1][l] = e[1] * scale;
+      a[3][l] = e[2] * scale;
+      a[4][l] = e[3] * scale;
+    }
+    const StraightSimplexRatio<kW> r = straight_triangle_ratio<kW>(a, beta, jinv);
+    ASSERT_EQ(r.ok, (1u << kW) - 1) << exact;
+    for (int l = 0; l < kW; ++l) {
+      EXPECT_LE(r.lower[l], exact * (1 + 1e-15)) << exact;
+      EXPECT_GE(r.upper[l], exact * (1 - 1e-15)) << exact;
+      EXPECT_LT(r.upper[l] - r.lower[l], 1e-12) << exact;
+    }
+  }
 }
 
 // Simplices of `type` at random, tetrahedra or triangles in the plane z = 0.25:
@@ -158,7 +242,7 @@ int expect_check_matches_alone(const ElementType& type, const std::vector<std::v
 // The check's chunks (mu of the valid straight-sided tetrahedra 8 at a time) give each
 // element exactly what mu_bounds gives it alone, the fallbacks included, for first-order
 // tetrahedra and for quadratic and cubic ones (straight, with a margin, or curved).
-TEST(StraightTetMu, CheckChunksMatchMuBoundsBitForBit) {
+TEST(StraightSimplexMu, CheckChunksMatchMuBoundsBitForBit) {
   std::mt19937 rng(77);
   for (const int id : {4, 11, 29}) {
     const ElementType& type = *find_element_type(id);
@@ -170,10 +254,24 @@ TEST(StraightTetMu, CheckChunksMatchMuBoundsBitForBit) {
   }
 }
 
+// The same for planar triangles (first order, quadratic, cubic), whose mu the chunks take
+// in lanes too.
+TEST(StraightSimplexMu, CheckChunksMatchTriangleMuBoundsBitForBit) {
+  std::mt19937 rng(80);
+  for (const int id : {2, 9, 21}) {
+    const ElementType& type = *find_element_type(id);
+    SCOPED_TRACE(std::string(type.name));
+    const int valid = expect_check_matches_alone(
+        type, random_simplices(type, 1500, rng), CheckMeasure::mu,
+        [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, true); });
+    EXPECT_GT(valid, 700);
+  }
+}
+
 // The same for the scaled Jacobian: the check's chunks take the closed form of
 // straight-sided simplices four tetrahedra at a time (straight_simplex_sj_lanes), bit for bit
 // what scaled_jacobian_bounds gives each element alone.
-TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
+TEST(StraightSimplexMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
   std::mt19937 rng(78);
   for (const int id : {4, 11, 29}) {
     const ElementType& type = *find_element_type(id);
@@ -188,7 +286,7 @@ TEST(StraightTetMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
 }
 
 // The same for planar triangles, whose scaled Jacobian the chunks take in lanes too.
-TEST(StraightTetMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
+TEST(StraightSimplexMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
   std::mt19937 rng(79);
   for (const int id : {2, 9, 21}) {
     const ElementType& type = *find_element_type(id);
@@ -207,7 +305,7 @@ TEST(StraightTetMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
 // whose closed form misses the tolerance, is left to that call. The closed form of a
 // straight tetrahedron is the scaled Jacobian's exact value up to rounding: sj of the
 // regular tetrahedron is 1, at every scale and orientation.
-TEST(StraightTetMu, ScaledJacobianLanesAreEachElementsOwnBounds) {
+TEST(StraightSimplexMu, ScaledJacobianLanesAreEachElementsOwnBounds) {
   std::mt19937 rng(5151);
   const ElementType& type = *find_element_type(4);
   constexpr int kW = kNativeLanes;
