@@ -44,6 +44,7 @@
 #include <optional>
 #include <span>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/straight_sided.hpp"
 #include "quadval/element_type.hpp"
 #include "quadval/quality_bounds.hpp"
@@ -61,5 +62,16 @@ std::optional<QualityBounds> bilinear_quad_sj_bounds(const ElementType& type, st
 /// The same for mu(E).
 std::optional<QualityBounds> bilinear_quad_mu_bounds(const ElementType& type, std::span<const double> x,
                                                      double tol, const KnownMargin* known = nullptr);
+
+/// The same bounds of kNativeLanes quadrangles at once, bit for bit those of the functions
+/// above (the same operations lane by lane): xy[2 k], xy[2 k + 1] the x and y of vertex k,
+/// beta[0], beta[1] and margin the element's straight-sided margins (as KnownMargin's; 0 at
+/// order 1). Bit l of the result is set where out[l] holds lane l's bounds; the function
+/// above gives the others nothing (they need the general path). The callers' switches
+/// (mu_use_constant_path, scaled_jacobian_use_straight_path) are theirs to check.
+unsigned bilinear_quad_sj_lanes(const Lanes<kNativeLanes>* xy, const Lanes<kNativeLanes>* beta,
+                                Lanes<kNativeLanes> margin, double tol, QualityBounds* out);
+unsigned bilinear_quad_mu_lanes(const Lanes<kNativeLanes>* xy, const Lanes<kNativeLanes>* beta,
+                                Lanes<kNativeLanes> margin, double tol, QualityBounds* out);
 
 }  // namespace quadval

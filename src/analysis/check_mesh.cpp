@@ -27,9 +27,11 @@
 #include "analysis/jacobian_samples.hpp"
 #include "analysis/jacobian_space.hpp"
 #include "analysis/lane_vector.hpp"
+#include "analysis/bilinear_quad_quality.hpp"
 #include "analysis/check_summary.hpp"
 #include "analysis/linear_jacobian.hpp"
 #include "analysis/straight_sided.hpp"
+#include "analysis/mu_constant.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
@@ -386,10 +388,10 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     std::vector<std::size_t> rest;
     std::vector<JacobianBounds> fast_bounds;
     bool decided[kLinearChunk];
-    std::vector<QualityBounds> lane_mu, lane_sj, lane_planar_mu, lane_simplex_sj;
+    std::vector<QualityBounds> lane_mu, lane_sj, lane_planar_mu, lane_straight_sj;
     std::vector<double> validity_ticks;
     std::vector<char> lane_sj_done, lane_mu_planar_done;
-    unsigned lane_mu_done[kLinearChunk / kNativeLanes], lane_simplex_sj_done[kLinearChunk / kNativeLanes];
+    unsigned lane_mu_done[kLinearChunk / kNativeLanes], lane_straight_sj_done[kLinearChunk / kNativeLanes];
     const Buffer own = batched ? Buffer{} : make_buffer(kFastChunk);  // the largest chunk
     for (;;) {
       const std::size_t claimed = next_chunk.fetch_add(1, std::memory_order_relaxed);
@@ -483,59 +485,68 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
-            // mu and the scaled Jacobian of a chunk's valid straight-sided tetrahedra and
-            // planar triangles (decided by
-            // linear_validity_chunk, vertices in `soa` by vertex and axis, rows of `row`, z
-            // not read for triangles; betas and js: the straight-sided margins of the columns,
-            // 3 per element, and of J, or none for first-order ones), W = kNativeLanes at a
-            // time (straight_simplex_mu.hpp, straight_simplex_sj_lanes): bit i % W of
+            // mu and the scaled Jacobian of a chunk's valid straight-sided tetrahedra, planar
+            // triangles and planar bilinear quadrangles (decided by linear_validity_chunk,
+            // vertices in `soa` by vertex and axis, rows of `row`, z not read in 2D; betas
+            // and js: the straight-sided margins of the columns, 3 per element, and of J, or
+            // none for first-order ones), W = kNativeLanes at a time (straight_simplex_mu.hpp,
+            // straight_simplex_sj_lanes, bilinear_quad_quality.hpp): bit i % W of
             // lane_mu_done[i / W] set where lane_mu[i] holds element i's mu as mu_bounds_given
-            // would compute it, likewise lane_simplex_sj_done and lane_simplex_sj for the
+            // would compute it, likewise lane_straight_sj_done and lane_straight_sj for the
             // scaled Jacobian.
-            const auto simplex_lanes_of = [&](const ElementType& t, std::size_t row, const double* betas,
-                                              const double* js, std::size_t count) {
+            const auto straight_lanes_of = [&](const ElementType& t, std::size_t row, const double* betas,
+                                               const double* js, std::size_t count) {
               const bool tet = t.family == ElementFamily::tetrahedron;
-              const bool lane_mu_wanted = want_mu && mu_supported(t);
-              const bool lane_sj_wanted = want_sj && scaled_jacobian_supported(t);
+              const bool quad = t.family == ElementFamily::quadrangle;
+              const bool lane_mu_wanted = want_mu && mu_supported(t) && (!quad || mu_constant_path_enabled());
+              const bool lane_sj_wanted =
+                  want_sj && scaled_jacobian_supported(t) && (!quad || scaled_jacobian_straight_path_enabled());
               const std::size_t edge_values = tet ? 9 : 6;  // 3 or 2 edges, x y z each
               lane_mu.resize(kLinearChunk);
-              lane_simplex_sj.resize(kLinearChunk);
+              lane_straight_sj.resize(kLinearChunk);
               constexpr std::size_t kW = kNativeLanes;
               for (std::size_t i0 = 0; i0 < count; i0 += kW) {
                 Lanes<kW> edges[9] = {}, margin[3] = {}, j_margin{};
                 unsigned valid = 0;
                 for (std::size_t l = 0; l < kW; ++l) {
                   const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
-                  for (std::size_t v = 0; v < edge_values; ++v)  // vertex v / 3 + 1 minus vertex 0, axis v % 3
-                    if (tet || v % 3 != 2)  // a planar triangle's z edges: x - x = +0, as computed alone
-                      edges[v][l] = soa[(3 + v) * row + i] - soa[(v % 3) * row + i];
+                  if (quad) {
+                    for (std::size_t v = 0; v < 8; ++v)  // x, y of vertex v / 2
+                      edges[v][l] = soa[(3 * (v / 2) + v % 2) * row + i];
+                  } else {
+                    for (std::size_t v = 0; v < edge_values; ++v)  // vertex v / 3 + 1 minus vertex 0, axis v % 3
+                      if (tet || v % 3 != 2)  // a planar triangle's z edges: x - x = +0, as computed alone
+                        edges[v][l] = soa[(3 + v) * row + i] - soa[(v % 3) * row + i];
+                  }
                   for (std::size_t c = 0; c < 3 && betas; ++c) margin[c][l] = betas[3 * i + c];
                   if (js) j_margin[l] = js[i];
                   if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid &&
                       (!betas || std::isfinite(margins[i])))
                     valid |= 1u << l;
                 }
+                QualityBounds* mu_out = lane_mu.data() + i0;
+                QualityBounds* sj_out = lane_straight_sj.data() + i0;
                 lane_mu_done[i0 / kW] =
-                    valid != 0 && lane_mu_wanted
-                        ? valid & straight_simplex_mu_lanes(t, edges, margin, qo.abs_tol, lane_mu.data() + i0)
-                        : 0u;
-                lane_simplex_sj_done[i0 / kW] =
-                    valid != 0 && lane_sj_wanted
-                        ? valid & straight_simplex_sj_lanes(t, edges, margin, j_margin, qo.abs_tol,
-                                                            lane_simplex_sj.data() + i0)
-                        : 0u;
+                    valid == 0 || !lane_mu_wanted ? 0u
+                    : quad ? valid & bilinear_quad_mu_lanes(edges, margin, j_margin, qo.abs_tol, mu_out)
+                           : valid & straight_simplex_mu_lanes(t, edges, margin, qo.abs_tol, mu_out);
+                lane_straight_sj_done[i0 / kW] =
+                    valid == 0 || !lane_sj_wanted ? 0u
+                    : quad ? valid & bilinear_quad_sj_lanes(edges, margin, j_margin, qo.abs_tol, sj_out)
+                           : valid & straight_simplex_sj_lanes(t, edges, margin, j_margin, qo.abs_tol, sj_out);
               }
             };
             // Whether a chunk of that first-order kind (or straight-sided elements of it) has
-            // results in simplex_lanes_of's lanes.
-            const auto simplex_lanes_for = [&](LinearKind kind) {
-              return (want_mu || want_sj) && (kind == LinearKind::tetrahedron || kind == LinearKind::triangle);
+            // results in straight_lanes_of's lanes.
+            const auto straight_lanes_for = [&](LinearKind kind) {
+              return (want_mu || want_sj) && (kind == LinearKind::tetrahedron || kind == LinearKind::triangle ||
+                                               kind == LinearKind::quadrangle);
             };
             const auto lane_of = [&](const unsigned* done, std::vector<QualityBounds>& lane, std::size_t i) {
               return ((done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane[i] : nullptr;
             };
             // mu and the scaled Jacobian of an element decided by the first-order chunk, from
-            // its nodes, where its chunk's lanes (simplex_lanes_of) did not settle them.
+            // its nodes, where its chunk's lanes (straight_lanes_of) did not settle them.
             const auto first_order_qualities = [&](std::size_t index, std::size_t element, Validity v,
                                                    const KnownMargin* known, const QualityBounds* mu_given,
                                                    const QualityBounds* sj_given) __attribute__((noinline)) {
@@ -564,7 +575,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               const std::size_t i = index - ch.out;
               const QualityBounds* mu_given = in_lanes && want_mu ? lane_of(lane_mu_done, lane_mu, i) : nullptr;
               const QualityBounds* sj_given =
-                  in_lanes && want_sj ? lane_of(lane_simplex_sj_done, lane_simplex_sj, i) : nullptr;
+                  in_lanes && want_sj ? lane_of(lane_straight_sj_done, lane_straight_sj, i) : nullptr;
               if ((want_mu && !mu_given) || (want_sj && !sj_given)) {
                 first_order_qualities(index, element, b.validity, known, mu_given, sj_given);
                 return;
@@ -599,16 +610,16 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               fast_bounds.resize(ch.count);
               linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
               const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
-              const bool simplex_lanes = simplex_lanes_for(fast);
-              if (simplex_lanes)  // outside the stage times
-                simplex_lanes_of(type, kLinearRow, nullptr, nullptr, ch.count);
+              const bool straight_lanes = straight_lanes_for(fast);
+              if (straight_lanes)  // outside the stage times
+                straight_lanes_of(type, kLinearRow, nullptr, nullptr, ch.count);
               nodes.resize(nn * 3);
               errors.resize(1);
               for (std::size_t i = 0; i < ch.count; ++i) {
                 ElementCheck& ec = elements[ch.out + i];
                 const auto conn = blk.element(ch.first + i);
                 if (decided[i]) {
-                  finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share, nullptr, simplex_lanes);
+                  finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share, nullptr, straight_lanes);
                   continue;
                 }
                 const std::uint64_t te = stage_ticks();
@@ -635,7 +646,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               // element by element.
               std::size_t left = 0;
               rest.resize(ch.count);
-              bool simplex_lanes = false;
+              bool straight_lanes = false;
               // Whether margins and betas hold every element's margin (curved ones' too:
               // infinite), which mu and the scaled Jacobian then need not compute again
               // (quadval_bench, one thread, 6 x 3 interleaved runs, medians: plate_quad_h0.08
@@ -673,13 +684,13 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   fast_bounds.resize(ch.count);
                   linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
                                         margins.data(), kRow);
-                  simplex_lanes = simplex_lanes_for(straight->kind());
+                  straight_lanes = straight_lanes_for(straight->kind());
                 } else {
                   std::fill(decided, decided + ch.count, false);  // a chunk of curved elements
                 }
                 const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
-                if (simplex_lanes)  // outside the stage times
-                  simplex_lanes_of(type, kRow, betas.data(), margins.data(), ch.count);
+                if (straight_lanes)  // outside the stage times
+                  straight_lanes_of(type, kRow, betas.data(), margins.data(), ch.count);
                 for (std::size_t i = 0; i < ch.count; ++i) {
                   if (!decided[i]) {
                     rest[left++] = i;
@@ -687,7 +698,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   }
                   const KnownMargin known = known_margin(i);
                   finish_first_order(ch.out + i, ch.first + i, fast_bounds[i], share,
-                                     want_mu || want_sj ? &known : nullptr, simplex_lanes);
+                                     want_mu || want_sj ? &known : nullptr, straight_lanes);
                 }
               } else {
                 for (std::size_t i = 0; i < ch.count; ++i) rest[left++] = i;

@@ -631,6 +631,7 @@ std::optional<QualityBounds> straight_simplex_bounds(const ScaledJacobianSpace& 
 }  // namespace
 
 void scaled_jacobian_use_straight_path(bool on) noexcept { use_straight_path = on; }
+bool scaled_jacobian_straight_path_enabled() noexcept { return use_straight_path; }
 
 unsigned straight_simplex_sj_lanes(const ElementType& type, const LaneBlock* edges, const LaneBlock* beta,
                                    LaneBlock margin, double tol, QualityBounds* out) {

@@ -105,6 +105,7 @@ QualityBounds scaled_jacobian_signed_stage(const ElementType& type, std::span<co
 /// pyramids (trilinear_hex_sj.hpp, linear_pyramid_sj.hpp), to compare them with the
 /// general path.
 void scaled_jacobian_use_straight_path(bool on) noexcept;
+bool scaled_jacobian_straight_path_enabled() noexcept;
 
 /// Tests only: switch off (on by default), in the calling thread, the paired bound of the
 /// first stage of valid elements (3D, planar 2D; scaled_jacobian_quotient.cpp,

@@ -13,6 +13,7 @@
 #include "analysis/mu_space.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/straight_simplex_mu.hpp"
+#include "check_alone_test_util.hpp"
 #include "jacobian_test_util.hpp"
 #include "quadval/check_report.hpp"
 #include "quadval/element_type.hpp"
@@ -212,33 +213,6 @@ std::vector<std::vector<double>> random_simplices(const ElementType& type, int c
   return elements;
 }
 
-// check_mesh of `elements` (all of `type`) for `measure`, on two threads: each element's
-// bounds (of mu or of the scaled Jacobian, as `measure`) bit for bit those `alone` gives
-// it; returns how many of them have a positive lower bound.
-template <class Alone>
-int expect_check_matches_alone(const ElementType& type, const std::vector<std::vector<double>>& elements,
-                               CheckMeasure measure, Alone alone) {
-  CheckOptions o;
-  o.measure = measure;
-  o.threads = 2;
-  const CheckReport r = check_mesh(test::mesh_of_elements(type, elements), o);
-  const std::vector<QualityBounds>& got = measure == CheckMeasure::mu ? r.mu : r.sj;
-  EXPECT_EQ(got.size(), elements.size());
-  if (got.size() != elements.size()) return 0;
-  QualityOptions q;
-  q.abs_tol = o.quality_abs_tol;
-  int positive = 0;
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    const QualityBounds own = alone(elements[e], q);
-    EXPECT_EQ(got[e].lower, own.lower) << "element " << e;
-    EXPECT_EQ(got[e].upper, own.upper) << "element " << e;
-    EXPECT_EQ(got[e].subdivisions, own.subdivisions) << "element " << e;
-    EXPECT_EQ(got[e].tolerance_met, own.tolerance_met) << "element " << e;
-    if (own.lower > 0) ++positive;
-  }
-  return positive;
-}
-
 // The check's chunks (mu of the valid straight-sided tetrahedra 8 at a time) give each
 // element exactly what mu_bounds gives it alone, the fallbacks included, for first-order
 // tetrahedra and for quadratic and cubic ones (straight, with a margin, or curved).
@@ -247,7 +221,7 @@ TEST(StraightSimplexMu, CheckChunksMatchMuBoundsBitForBit) {
   for (const int id : {4, 11, 29}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const int valid = expect_check_matches_alone(
+    const int valid = test::expect_check_matches_alone(
         type, random_simplices(type, 1500, rng), CheckMeasure::mu,
         [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, false); });
     EXPECT_GT(valid, 700);
@@ -261,7 +235,7 @@ TEST(StraightSimplexMu, CheckChunksMatchTriangleMuBoundsBitForBit) {
   for (const int id : {2, 9, 21}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const int valid = expect_check_matches_alone(
+    const int valid = test::expect_check_matches_alone(
         type, random_simplices(type, 1500, rng), CheckMeasure::mu,
         [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, true); });
     EXPECT_GT(valid, 700);
@@ -276,7 +250,7 @@ TEST(StraightSimplexMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
   for (const int id : {4, 11, 29}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const int valid = expect_check_matches_alone(
+    const int valid = test::expect_check_matches_alone(
         type, random_simplices(type, 1500, rng), CheckMeasure::scaled_jacobian,
         [&](const std::vector<double>& x, const QualityOptions& q) {
           return scaled_jacobian_bounds(type, x, q, false);
@@ -291,7 +265,7 @@ TEST(StraightSimplexMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
   for (const int id : {2, 9, 21}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const int valid = expect_check_matches_alone(
+    const int valid = test::expect_check_matches_alone(
         type, random_simplices(type, 1500, rng), CheckMeasure::scaled_jacobian,
         [&](const std::vector<double>& x, const QualityOptions& q) {
           return scaled_jacobian_bounds(type, x, q, true);

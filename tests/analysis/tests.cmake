@@ -6,6 +6,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   analysis/mu_bernstein_product_test.cpp
   analysis/mu_constant_test.cpp
   analysis/straight_simplex_mu_test.cpp
+  analysis/bilinear_quad_lanes_test.cpp
   analysis/trilinear_hex_mu_test.cpp
   analysis/linear_pyramid_mu_test.cpp
   analysis/linear_prism_mu_test.cpp
