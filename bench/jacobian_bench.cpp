@@ -54,6 +54,37 @@ Mesh linear_hexes(int n, double amp) {
   return m;
 }
 
+// n^2 first-order quadrangles, or 2 n^2 triangles, on the unit-spaced lattice of the plane
+// z = 0 with its nodes perturbed by up to `amp` (a few quadrangles fold at 0.3).
+Mesh linear_planar(int n, double amp, bool triangles) {
+  Mesh m;
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-amp, amp);
+  const auto id = [n](int i, int j) { return static_cast<NodeIndex>(i + (n + 1) * j); };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      m.node_tags.push_back(m.node_tags.size() + 1);
+      m.coords.insert(m.coords.end(), {i + u(rng), j + u(rng), 0.0});
+    }
+  ElementBlock b;
+  b.type = find_element_type(triangles ? 2 : 3);
+  b.entity_dim = 2;
+  b.entity_tag = 1;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const NodeIndex q[4] = {id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)};
+      if (triangles) {
+        b.nodes.insert(b.nodes.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+        b.tags.insert(b.tags.end(), {b.tags.size() + 1, b.tags.size() + 2});
+      } else {
+        b.nodes.insert(b.nodes.end(), {q[0], q[1], q[2], q[3]});
+        b.tags.push_back(b.tags.size() + 1);
+      }
+    }
+  m.blocks.push_back(std::move(b));
+  return m;
+}
+
 // 6 n^3 order-p tetrahedra; nodes on the lattice of step 1/p, all perturbed by up to amp/p.
 Mesh curved_tets(int n, int p, double amp) {
   Mesh m;
@@ -190,6 +221,21 @@ void BM_CheckLinearTetQuality(benchmark::State& state) {
 }
 // 6 * 40^3 = 384,000 tetrahedra
 BENCHMARK(BM_CheckLinearTetQuality)->ArgsProduct({{40}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
+
+// First-order planar triangles (2 n^2) and quadrangles (n^2), range 0 = n.
+void BM_CheckLinearTriangleQuality(benchmark::State& state) {
+  static const Mesh mesh = linear_planar(static_cast<int>(state.range(0)), 0.3, true);
+  run_quality(state, mesh);
+}
+// 2 * 400^2 = 320,000 triangles
+BENCHMARK(BM_CheckLinearTriangleQuality)->ArgsProduct({{400}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
+
+void BM_CheckLinearQuadQuality(benchmark::State& state) {
+  static const Mesh mesh = linear_planar(static_cast<int>(state.range(0)), 0.3, false);
+  run_quality(state, mesh);
+}
+// 500^2 = 250,000 quadrangles
+BENCHMARK(BM_CheckLinearQuadQuality)->ArgsProduct({{500}, {0, 1, 2}})->Unit(benchmark::kMillisecond);
 
 // First-order hexahedra, n^3 (range 0), vertices moved by up to 0.2 of the spacing.
 void BM_CheckLinearHexQuality(benchmark::State& state) {
