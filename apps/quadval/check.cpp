@@ -77,7 +77,10 @@ int run_check(const CheckCliOptions& o) {
     if (e != ".csv" && e != ".json" && e != ".vtu" && e != ".msh")
       throw InputError::in_file(out, "unknown output extension (expected .csv, .json, .vtu or .msh)");
   }
-  const Mesh mesh = read_mesh(o.input);
+  std::vector<std::string> read_warnings;
+  const Mesh mesh = read_mesh(o.input, &read_warnings);
+  if (!o.quiet)  // --quiet prints nothing, warnings included
+    for (const std::string& w : read_warnings) fmt::print(stderr, "quadval: warning: {}\n", w);
 
   CheckOptions opts;
   opts.measure = o.measure == "distortion"        ? CheckMeasure::distortion

@@ -102,6 +102,9 @@ TEST_F(CheckCli, AllValidMeshExitsZeroAndJsonVtuMshAreWritten) {
   EXPECT_NE(slurp(vtu).find("distortion_lower"), std::string::npos);
   EXPECT_NE(slurp(msh).find("$ElementData"), std::string::npos);
   EXPECT_EQ(run_cli("check -q " + in.string()).output, "");
+  // The fields' $ElementData is skipped with a warning, which --quiet leaves out too.
+  EXPECT_NE(run_cli("check " + msh.string()).err.find("$ElementData is not used"), std::string::npos);
+  EXPECT_EQ(run_cli("check -q " + msh.string()).output, "");
 }
 
 TEST_F(CheckCli, BadInputExitsTwo) {
