@@ -70,37 +70,47 @@ std::array<double, 9> random_edges(int e, std::mt19937& rng) {
   return a;
 }
 
-TEST(StraightSimplexMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
-  std::mt19937 rng(5150);
-  const std::array<double, 9>& jinv = mu_space(*find_element_type(4)).ideal_inverse();
+// straight_tet_ratio (dim 3) or straight_triangle_ratio (dim 2, edges 0 and 1 of
+// random_edges in the plane: z differences 0) at the checks' width, on random simplices:
+// each lane the same bits as the element alone (in both lanes of two), enclosing the
+// singular-value ratio, and tight.
+template <class Ratio>
+void expect_lanes_enclose_the_singular_value_ratio(int dim, unsigned seed, Ratio ratio) {
+  std::mt19937 rng(seed);
+  const std::array<double, 9>& jinv = mu_space(*find_element_type(dim == 3 ? 4 : 2)).ideal_inverse();
   constexpr int kW = kNativeLanes;  // the width the checks run at
   int ok = 0, total = 0;
   for (int block = 0; block < 400; ++block) {
     std::array<std::array<double, 9>, kW> edges;
     std::array<double, kW> margin{};
-    Lanes<kW> a[9], beta[3];
+    Lanes<kW> a[9] = {}, beta[3] = {};
     for (int l = 0; l < kW; ++l) {
-      edges[static_cast<std::size_t>(l)] = random_edges(block * kW + l, rng);
+      auto& x = edges[static_cast<std::size_t>(l)];
+      x = random_edges(block * kW + l, rng);
+      if (dim == 2) {
+        x[2] = x[5] = x[6] = x[7] = x[8] = 0;
+        if ((block * kW + l) % 5 == 1)  // nearly flat: edge 1 close to a multiple of edge 0
+          for (std::size_t k = 0; k < 2; ++k) x[3 + k] = 0.7 * x[k] + 1e-5 * std::abs(x[0]) * (k == 0 ? 1 : -1);
+      }
       // Half the blocks with a straight-sided margin on the columns (higher-order nodes).
-      margin[static_cast<std::size_t>(l)] = block % 2 == 0 ? 0.0 : 1e-9 * std::abs(edges[static_cast<std::size_t>(l)][0]);
-      for (int v = 0; v < 9; ++v) a[v][l] = edges[static_cast<std::size_t>(l)][static_cast<std::size_t>(v)];
-      for (int c = 0; c < 3; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
+      margin[static_cast<std::size_t>(l)] = block % 2 == 0 ? 0.0 : 1e-9 * std::abs(x[0]);
+      for (int v = 0; v < 3 * dim; ++v) a[v][l] = x[static_cast<std::size_t>(v)];
+      for (int c = 0; c < dim; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
     }
-    const StraightSimplexRatio<kW> r = straight_tet_ratio<kW>(a, beta, jinv);
+    const StraightSimplexRatio<kW> r = ratio(a, beta, jinv);
     for (int l = 0; l < kW; ++l) {
       ++total;
       const auto& x = edges[static_cast<std::size_t>(l)];
-      // The same element alone, in both lanes of two: the same bits.
-      Lanes<2> a2[9], b2[3];
-      for (int v = 0; v < 9; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
-      for (int c = 0; c < 3; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
-      const StraightSimplexRatio<2> alone = straight_tet_ratio<2>(a2, b2, jinv);
+      Lanes<2> a2[9] = {}, b2[3] = {};
+      for (int v = 0; v < 3 * dim; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
+      for (int c = 0; c < dim; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
+      const StraightSimplexRatio<2> alone = ratio(a2, b2, jinv);
       ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * kW + l;
       if (((r.ok >> l) & 1u) == 0) continue;
       ++ok;
       EXPECT_EQ(r.lower[l], alone.lower[0]);
       EXPECT_EQ(r.upper[l], alone.upper[0]);
-      const long double exact = exact_ratio(x.data(), jinv);
+      const long double exact = dim == 3 ? exact_ratio(x.data(), jinv) : exact_triangle_ratio(x.data(), jinv);
       EXPECT_LE(r.lower[l], exact * (1 + 1e-15L)) << "element " << block * kW + l;
       EXPECT_GE(r.upper[l], exact * (1 - 1e-15L)) << "element " << block * kW + l;
       EXPECT_LE(r.lower[l], r.upper[l]);
@@ -114,50 +124,20 @@ TEST(StraightSimplexMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
   EXPECT_GT(ok, total * 3 / 4);  // the rest: nearly degenerate, left to the general path
 }
 
-// The same for triangles: edges 0 and 1 of random_edges in the plane (z differences 0).
+TEST(StraightSimplexMu, LanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
+  expect_lanes_enclose_the_singular_value_ratio(3, 5150, [](const auto* a, const auto* beta, const auto& jinv) {
+    constexpr int kWidth = sizeof(*a) / sizeof(double);
+    return straight_tet_ratio<kWidth>(a, beta, jinv);
+  });
+}
+
 TEST(StraightSimplexMu, TriangleLanesEncloseTheSingularValueRatioAndAgreeAcrossLanes) {
-  std::mt19937 rng(5152);
-  const std::array<double, 9>& jinv = mu_space(*find_element_type(2)).ideal_inverse();
+  expect_lanes_enclose_the_singular_value_ratio(2, 5152, [](const auto* a, const auto* beta, const auto& jinv) {
+    constexpr int kWidth = sizeof(*a) / sizeof(double);
+    return straight_triangle_ratio<kWidth>(a, beta, jinv);
+  });
   constexpr int kW = kNativeLanes;
-  int ok = 0, total = 0;
-  for (int block = 0; block < 400; ++block) {
-    std::array<std::array<double, 9>, kW> edges;
-    std::array<double, kW> margin{};
-    Lanes<kW> a[9] = {}, beta[3] = {};
-    for (int l = 0; l < kW; ++l) {
-      auto& x = edges[static_cast<std::size_t>(l)];
-      x = random_edges(block * kW + l, rng);
-      x[2] = x[5] = x[6] = x[7] = x[8] = 0;
-      if ((block * kW + l) % 5 == 1)  // nearly flat: edge 1 close to a multiple of edge 0
-        for (std::size_t k = 0; k < 2; ++k) x[3 + k] = 0.7 * x[k] + 1e-5 * std::abs(x[0]) * (k == 0 ? 1 : -1);
-      margin[static_cast<std::size_t>(l)] = block % 2 == 0 ? 0.0 : 1e-9 * std::abs(x[0]);
-      for (int v = 0; v < 6; ++v) a[v][l] = x[static_cast<std::size_t>(v)];
-      for (int c = 0; c < 2; ++c) beta[c][l] = margin[static_cast<std::size_t>(l)];
-    }
-    const StraightSimplexRatio<kW> r = straight_triangle_ratio<kW>(a, beta, jinv);
-    for (int l = 0; l < kW; ++l) {
-      ++total;
-      const auto& x = edges[static_cast<std::size_t>(l)];
-      Lanes<2> a2[9] = {}, b2[3] = {};
-      for (int v = 0; v < 6; ++v) a2[v] = broadcast_lanes<2>(x[static_cast<std::size_t>(v)]);
-      for (int c = 0; c < 2; ++c) b2[c] = broadcast_lanes<2>(margin[static_cast<std::size_t>(l)]);
-      const StraightSimplexRatio<2> alone = straight_triangle_ratio<2>(a2, b2, jinv);
-      ASSERT_EQ((r.ok >> l) & 1u, alone.ok & 1u) << "element " << block * kW + l;
-      if (((r.ok >> l) & 1u) == 0) continue;
-      ++ok;
-      EXPECT_EQ(r.lower[l], alone.lower[0]);
-      EXPECT_EQ(r.upper[l], alone.upper[0]);
-      const long double exact = exact_triangle_ratio(x.data(), jinv);
-      EXPECT_LE(r.lower[l], exact * (1 + 1e-15L)) << "element " << block * kW + l;
-      EXPECT_GE(r.upper[l], exact * (1 - 1e-15L)) << "element " << block * kW + l;
-      EXPECT_LE(r.lower[l], r.upper[l]);
-      const double gap = margin[static_cast<std::size_t>(l)] == 0 ? 1e-7 : 1e-4;
-      if (exact > 1e-3L) {
-        EXPECT_LE(r.upper[l] - r.lower[l], gap * static_cast<double>(exact)) << "element " << block * kW + l;
-      }
-    }
-  }
-  EXPECT_GT(ok, total * 3 / 4);
+  const std::array<double, 9>& jinv = mu_space(*find_element_type(2)).ideal_inverse();
   // Closed forms, each at scales 2^-15 .. 2^15: the equilateral triangle R = 1; stretched
   // by 3 along x, R = 1/9 (the ratio of its stretches, squared); the right isosceles one
   // with legs along the axes, W = Jinv = [1, -1/sqrt 3; 0, 2/sqrt 3], W^T W with
@@ -213,64 +193,26 @@ std::vector<std::vector<double>> random_simplices(const ElementType& type, int c
   return elements;
 }
 
-// The check's chunks (mu of the valid straight-sided tetrahedra 8 at a time) give each
-// element exactly what mu_bounds gives it alone, the fallbacks included, for first-order
-// tetrahedra and for quadratic and cubic ones (straight, with a margin, or curved).
-TEST(StraightSimplexMu, CheckChunksMatchMuBoundsBitForBit) {
+// The check's chunks (mu and the scaled Jacobian of valid straight-sided tetrahedra and
+// planar triangles, kNativeLanes at a time) give each element exactly what mu_bounds and
+// scaled_jacobian_bounds give it alone, the fallbacks included, for first-order elements
+// and quadratic and cubic ones (straight, with a margin, or curved).
+TEST(StraightSimplexMu, CheckChunksMatchEachElementAloneBitForBit) {
   std::mt19937 rng(77);
-  for (const int id : {4, 11, 29}) {
+  for (const int id : {4, 11, 29, 2, 9, 21}) {
     const ElementType& type = *find_element_type(id);
     SCOPED_TRACE(std::string(type.name));
-    const int valid = test::expect_check_matches_alone(
-        type, random_simplices(type, 1500, rng), CheckMeasure::mu,
-        [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, false); });
-    EXPECT_GT(valid, 700);
-  }
-}
-
-// The same for planar triangles (first order, quadratic, cubic), whose mu the chunks take
-// in lanes too.
-TEST(StraightSimplexMu, CheckChunksMatchTriangleMuBoundsBitForBit) {
-  std::mt19937 rng(80);
-  for (const int id : {2, 9, 21}) {
-    const ElementType& type = *find_element_type(id);
-    SCOPED_TRACE(std::string(type.name));
-    const int valid = test::expect_check_matches_alone(
-        type, random_simplices(type, 1500, rng), CheckMeasure::mu,
-        [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, true); });
-    EXPECT_GT(valid, 700);
-  }
-}
-
-// The same for the scaled Jacobian: the check's chunks take the closed form of
-// straight-sided simplices four tetrahedra at a time (straight_simplex_sj_lanes), bit for bit
-// what scaled_jacobian_bounds gives each element alone.
-TEST(StraightSimplexMu, CheckChunksMatchScaledJacobianBoundsBitForBit) {
-  std::mt19937 rng(78);
-  for (const int id : {4, 11, 29}) {
-    const ElementType& type = *find_element_type(id);
-    SCOPED_TRACE(std::string(type.name));
-    const int valid = test::expect_check_matches_alone(
-        type, random_simplices(type, 1500, rng), CheckMeasure::scaled_jacobian,
-        [&](const std::vector<double>& x, const QualityOptions& q) {
-          return scaled_jacobian_bounds(type, x, q, false);
-        });
-    EXPECT_GT(valid, 700);
-  }
-}
-
-// The same for planar triangles, whose scaled Jacobian the chunks take in lanes too.
-TEST(StraightSimplexMu, CheckChunksMatchTriangleScaledJacobianBoundsBitForBit) {
-  std::mt19937 rng(79);
-  for (const int id : {2, 9, 21}) {
-    const ElementType& type = *find_element_type(id);
-    SCOPED_TRACE(std::string(type.name));
-    const int valid = test::expect_check_matches_alone(
-        type, random_simplices(type, 1500, rng), CheckMeasure::scaled_jacobian,
-        [&](const std::vector<double>& x, const QualityOptions& q) {
-          return scaled_jacobian_bounds(type, x, q, true);
-        });
-    EXPECT_GT(valid, 700);
+    const bool planar = type.dim == 2;
+    const auto elements = random_simplices(type, 1500, rng);
+    EXPECT_GT(test::expect_check_matches_alone(
+                  type, elements, CheckMeasure::mu,
+                  [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(type, x, q, planar); }),
+              700);
+    EXPECT_GT(test::expect_check_matches_alone(type, elements, CheckMeasure::scaled_jacobian,
+                                               [&](const std::vector<double>& x, const QualityOptions& q) {
+                                                 return scaled_jacobian_bounds(type, x, q, planar);
+                                               }),
+              700);
   }
 }
 
