@@ -80,9 +80,16 @@ constexpr int kSignedSplits = 8;
 // warped_tetrahedron_o3 and none stuck there after 3 splits, and the full bounds settle them
 // for less than the splits cost. Each inverted element best of 3, one thread, two runs:
 // warped_tetrahedron_o3 56.6 -> 45.4 ms, tets_h0.8_o2 0.27 -> 0.23 ms, mixed_h0.6_o2's
-// tetrahedra 14.0 -> 13.6 ms. Not for the others: warped_pyramid_o2 0.63 -> 1.7 ms,
-// mixed_h0.6_o2's hexahedra 0.25 -> 0.93 ms (its pyramids 14.1 -> 13.2 ms).
-bool signed_floor_root_ends(const ElementType& type) { return type.family == ElementFamily::tetrahedron; }
+// tetrahedra 14.0 -> 13.6 ms. Planar triangles at the floor go to the probe at once
+// (below) instead: tri_h0.4_o4's 60 inverted ones, each best of 30, 372 -> 276 us in all;
+// 22 of them change, 18 faster (its two hardest, whose minimum lies 0.019 above the floor,
+// 54 -> 28 and 61 -> 37 us), 4 slower (3-5 -> 8-9 us), all tighter. Not for the others:
+// warped_pyramid_o2 0.63 -> 1.7 ms, mixed_h0.6_o2's hexahedra 0.25 -> 0.93 ms (its
+// pyramids 14.1 -> 13.2 ms), quad_h0.4_o2's 28 inverted quadrangles 166 -> 226 us (a
+// quadrangle's probe costs more than the one split that settles most of them).
+bool signed_floor_root_ends(const ElementType& type) {
+  return type.family == ElementFamily::tetrahedron || type.family == ElementFamily::triangle;
+}
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
 // rounding of at most u per operation; the final bounds are enlarged by 1% to cover the

@@ -113,8 +113,9 @@ unsigned paired_quotient_roots(const ScaledJacobianSpace& space, const QuotientL
 /// bound of sj(E), at most 0). Nothing (lower = -inf, upper) where J does not lie in the
 /// space of the product of the columns (none of the 2D and 3D types). floor_root_ends: no
 /// split where the root's bound is at the Hadamard floor -s (a frame column turning
-/// through a fold on the element), for the families where the full bounds settle such
-/// elements for less than these splits cost (tetrahedra, scaled_jacobian.cpp).
+/// through a fold on the element), for the families where the full bounds (tetrahedra) or
+/// the probe (planar triangles) settle such elements for less than these splits cost
+/// (scaled_jacobian.cpp).
 QualityBounds signed_quotient_bounds(const ScaledJacobianSpace& space, const QuotientInput& in, double tol,
                                      int max_splits, double upper = 0, FrameBounds* frame_lower = nullptr,
                                      bool floor_root_ends = false);
