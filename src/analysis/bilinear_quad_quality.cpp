@@ -7,7 +7,7 @@
 #include <limits>
 
 #include "analysis/outward_rounding.hpp"
-#include "analysis/symmetric3_lanes.hpp"
+#include "analysis/scalar_or_lanes.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 
@@ -18,14 +18,8 @@ constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // T = double for one element, LaneBlock for one element per lane: the same operations, so
-// the same bits (lane_vector.hpp). Their one-ulp steps and square roots.
-using LaneBlock = Lanes<kNativeLanes>;
-double down(double x) { return next_down(x); }
-double up(double x) { return next_up(x); }
-double root(double x) { return sqrt_rn(x); }
-LaneBlock down(LaneBlock x) { return lanes3::down<kNativeLanes>(x); }
-LaneBlock up(LaneBlock x) { return lanes3::up<kNativeLanes>(x); }
-LaneBlock root(LaneBlock x) { return lanes3::root<kNativeLanes>(x); }
+// the same bits (scalar_or_lanes.hpp).
+using namespace scalar_or_lanes;
 template <class T>
 using MaskOf = decltype(T{} < T{});
 // Logical not of a bool or of a lane mask (all ones or zero per lane).

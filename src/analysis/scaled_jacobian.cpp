@@ -24,6 +24,7 @@
 #include "analysis/ratio_scan.hpp"
 #include "analysis/scaled_jacobian_probe.hpp"
 #include "analysis/scaled_jacobian_quotient.hpp"
+#include "analysis/scalar_or_lanes.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
@@ -39,8 +40,7 @@ namespace {
 
 constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-double down(double x) { return next_down(x); }
-double up(double x) { return next_up(x); }
+using namespace scalar_or_lanes;  // up, down and root of doubles and of lanes
 // Splits of J and the columns before the products, where the paired bound does not apply
 // (lines, and the tests' switch; the quotient stage refines only a root within twice the
 // tolerance). Measured on the shared curved meshes at --tol 1e-2:
@@ -534,14 +534,6 @@ const SimplexFrameColumns& simplex_frame_columns(const ScaledJacobianSpace& spac
   static const SimplexFrameColumns triangle = make_simplex_frame_columns(space);
   return triangle;
 }
-
-// One-ulp steps and square roots of T = double or lanes: the lanes' are next_up, next_down
-// and sqrt's bits (symmetric3_lanes.hpp).
-using LaneBlock = Lanes<kNativeLanes>;
-LaneBlock up(LaneBlock x) { return lanes3::up<kNativeLanes>(x); }
-LaneBlock down(LaneBlock x) { return lanes3::down<kNativeLanes>(x); }
-double root(double x) { return sqrt_rn(x); }
-LaneBlock root(LaneBlock x) { return lanes3::root<kNativeLanes>(x); }
 
 template <class T>
 struct StraightSj {
