@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 #include "analysis/outward_rounding.hpp"
 #include "analysis/scalar_or_lanes.hpp"
@@ -26,6 +27,17 @@ using MaskOf = decltype(T{} < T{});
 template <class M>
 M negation(M m) {
   return m == M{};
+}
+// Whether a bool, or any lane of a mask, is true.
+template <class M>
+bool any_lane(M m) {
+  if constexpr (std::is_same_v<M, bool>) {
+    return m;
+  } else {
+    for (std::size_t l = 0; l < sizeof(M) / sizeof(m[0]); ++l)
+      if (m[l] != 0) return true;
+    return false;
+  }
 }
 
 // An edge vector (x, y) of the first-order quadrangle, with bounds of its exact norm and
@@ -142,17 +154,19 @@ Bounds<T> sj_bounds(const Quad<T>& quad, double tol) {
     found = found | better;
   }
   Bounds<T> out{s_lo, upper, quad.ok};
-  // Curved: widened by the margins.
-  const T j_lo = quad.j_lo(), m = quad.m;
-  const T a_max = vmax(quad.e[0].norm_hi, quad.e[1].norm_hi) / 2;
-  const T b_max = vmax(quad.f[0].norm_hi, quad.f[1].norm_hi) / 2;
-  const T a_lo = down(j_lo / b_max), b_lo = down(j_lo / a_max);
-  const T shrink = up(up(1 + up(quad.beta[0] / a_lo)) * up(1 + up(quad.beta[1] / b_lo)));
-  const T a = down(least_a_norm_lo / 2 - quad.beta[0]), b = down(least_b_norm_lo / 2 - quad.beta[1]);
+  // Curved (none at order 1: skipped): widened by the margins.
   const MaskOf<T> curved = quad.curved();
-  out.ok = out.ok & (negation(curved) | ((j_lo > m) & found & (a > 0) & (b > 0)));
-  out.lower = curved ? down(down(s_lo * down(1 - up(m / j_lo))) / shrink) : out.lower;
-  out.upper = curved ? up(up(least_cross_hi / 4 + m) / down(a * b)) : out.upper;
+  if (any_lane(curved)) {
+    const T j_lo = quad.j_lo(), m = quad.m;
+    const T a_max = vmax(quad.e[0].norm_hi, quad.e[1].norm_hi) / 2;
+    const T b_max = vmax(quad.f[0].norm_hi, quad.f[1].norm_hi) / 2;
+    const T a_lo = down(j_lo / b_max), b_lo = down(j_lo / a_max);
+    const T shrink = up(up(1 + up(quad.beta[0] / a_lo)) * up(1 + up(quad.beta[1] / b_lo)));
+    const T a = down(least_a_norm_lo / 2 - quad.beta[0]), b = down(least_b_norm_lo / 2 - quad.beta[1]);
+    out.ok = out.ok & (negation(curved) | ((j_lo > m) & found & (a > 0) & (b > 0)));
+    out.lower = curved ? down(down(s_lo * down(1 - up(m / j_lo))) / shrink) : out.lower;
+    out.upper = curved ? up(up(least_cross_hi / 4 + m) / down(a * b)) : out.upper;
+  }
   out.upper = vmin(out.upper, T{} + 1);  // sj <= 1 for quadrangles (Hadamard)
   within(out, tol);
   return out;
@@ -174,20 +188,22 @@ Bounds<T> mu_bounds(const Quad<T>& quad, double tol) {
     found = found | better;
   }
   Bounds<T> out{r_lo, upper, quad.ok};
-  // Curved: the singular values move by at most eps.
-  const T eps = up(root(up(up(quad.beta[0] * quad.beta[0]) + up(quad.beta[1] * quad.beta[1]))));
-  const T s = down(root(quad.j_lo()));
-  // At the least corner (columns a / 2, b / 2): sigma_max^2 = (t + sqrt(t^2 - 4 p^2)) / 2
-  // with t = |c_1|^2 + |c_2|^2 and p = J_1, and sigma_min = p / sigma_max.
-  const T t_lo = down(least_sq / 4), p_hi = up(least_cross_hi / 4);
-  const T p_lo = down(least_cross_lo / 4);
-  const T disc = vmax(T{}, down(down(t_lo * t_lo) - up(4 * up(p_hi * p_hi))));
-  const T max_lo = down(root(down(down(t_lo + down(root(disc))) / 2)));
-  const T min_hi = up(p_hi / max_lo);
+  // Curved (none at order 1: skipped): the singular values move by at most eps.
   const MaskOf<T> curved = quad.curved();
-  out.ok = out.ok & (negation(curved) | (found & (max_lo > eps) & (p_lo > 0)));
-  out.lower = curved ? down(down(down(r_lo * s) - eps) / up(s + eps)) : out.lower;
-  out.upper = curved ? vmin(T{} + 1, up(up(min_hi + eps) / down(max_lo - eps))) : out.upper;
+  if (any_lane(curved)) {
+    const T eps = up(root(up(up(quad.beta[0] * quad.beta[0]) + up(quad.beta[1] * quad.beta[1]))));
+    const T s = down(root(quad.j_lo()));
+    // At the least corner (columns a / 2, b / 2): sigma_max^2 = (t + sqrt(t^2 - 4 p^2)) / 2
+    // with t = |c_1|^2 + |c_2|^2 and p = J_1, and sigma_min = p / sigma_max.
+    const T t_lo = down(least_sq / 4), p_hi = up(least_cross_hi / 4);
+    const T p_lo = down(least_cross_lo / 4);
+    const T disc = vmax(T{}, down(down(t_lo * t_lo) - up(4 * up(p_hi * p_hi))));
+    const T max_lo = down(root(down(down(t_lo + down(root(disc))) / 2)));
+    const T min_hi = up(p_hi / max_lo);
+    out.ok = out.ok & (negation(curved) | (found & (max_lo > eps) & (p_lo > 0)));
+    out.lower = curved ? down(down(down(r_lo * s) - eps) / up(s + eps)) : out.lower;
+    out.upper = curved ? vmin(T{} + 1, up(up(min_hi + eps) / down(max_lo - eps))) : out.upper;
+  }
   within(out, tol);
   return out;
 }
