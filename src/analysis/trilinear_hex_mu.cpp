@@ -130,12 +130,13 @@ CertifiedRatio box_ratio(const double (*w)[8][3], double delta, double enough = 
   return control_matrix_ratio(m, kSlots, 8, w, err, delta, enough);
 }
 
-// A box of the reference cube: J's columns' control values on it, their error bound, and
-// R's bounds there.
+// A box of the reference cube: J's columns' control values on it, their error bound, the
+// certified lower bound of R at each of its corners, and its lower bound of R.
 struct Box {
   double w[3][8][3];
   double delta;
-  CertifiedRatio ratio;
+  double corner[8];
+  double lower;
   int depth;  // halvings from the root; the next one is along direction depth % 3
 };
 
@@ -176,6 +177,83 @@ void halve(const Box& box, int d, Box& low, Box& high) {
   low.depth = high.depth = box.depth + 1;
 }
 
+double largest_entry(const double (*w)[8][3]) {
+  double a = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int q = 0; q < 8; ++q)
+      for (int k = 0; k < 3; ++k) a = std::max(a, std::abs(w[c][q][k]));
+  return a;
+}
+
+// The bound on every control value's error (see the header), as box_ratio takes it.
+double entry_error(double a, double delta) {
+  return next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
+}
+
+// The metrics at 4 corners qs of a box (W's values there, each entry within err), in lanes:
+// each one's certified lower bound of R into ratio[i], and with `upper` set, its Rayleigh
+// quotients' upper bound of R folded into *upper. The corner values are the products
+// box_ratio takes at slots 0-7 (one pair each), so their bits are the same. false where a
+// metric is not certified positive definite.
+bool corner_ratios(const double (*w)[8][3], const int* qs, double err, double delta, double* ratio, double* upper) {
+  constexpr int kW = kNativeLanes;
+  if (!(err < kMax)) return false;
+  for (int part = 0; part < 4 / kW; ++part) {
+    Lanes<kW> m[6], wv[3][3];
+    for (int l = 0; l < kW; ++l) {
+      const int q = qs[kW * part + l];
+      for (int x = 0; x < 3; ++x) m[x][l] = dot(w[x][q], w[x][q]);
+      for (int e = 0; e < 3; ++e) m[3 + e][l] = dot(w[kCross[e][0]][q], w[kCross[e][1]][q]);
+      for (int j = 0; j < 3; ++j)
+        for (int c = 0; c < 3; ++c) wv[j][c][l] = w[j][q][c];
+    }
+    const ExtremeEigen<kW> eig = extreme_eigen<kW>(m, broadcast_lanes<kW>(err));
+    if (mask_bits<kW>(eig.ok & (eig.lo > 0)) != (1u << kW) - 1) return false;
+    const Lanes<kW> r = down<kW>(eig.lo / eig.hi);
+    for (int l = 0; l < kW; ++l) ratio[kW * part + l] = r[l];
+    if (upper == nullptr) continue;
+    Mask<kW> vectors_ok;
+    const Lanes<kW> u = ratio_upper<kW>(wv, m, eig.lo, eig.hi, broadcast_lanes<kW>(delta), vectors_ok);
+    for (int l = 0; l < kW; ++l) *upper = std::min(*upper, u[l]);
+  }
+  return true;
+}
+
+// The lower bound of R on a box whose corners' ratios are known: the least of those and of
+// its other 19 control matrices' (control_matrix_ratio's blocks 1-3: the cheap test at
+// min(lower so far, enough) first, an enclosure where it fails; 0 where a matrix is not
+// certified positive definite).
+double box_lower(const Box& box, double enough) {
+  const Layout& lay = layout();
+  const double err = entry_error(largest_entry(box.w), box.delta);
+  alignas(64) double m[6][kSlots];
+  for (int x = 0; x < 3; ++x) diagonal_entry(box.w[x], x, lay, m[x]);
+  for (int e = 0; e < 3; ++e) cross_entry(box.w, e, lay, m[3 + e]);
+  constexpr int kW = kNativeLanes, kParts = 8 / kW;
+  constexpr unsigned kAll = (1u << kW) - 1;
+  double lower = *std::min_element(box.corner, box.corner + 8);
+  for (int block = 1; block < kSlots / 8; ++block) {
+    Lanes<kW> mb[kParts][6];
+    for (int p = 0; p < kParts; ++p)
+      for (int e = 0; e < 6; ++e) mb[p][e] = load_lanes<kW>(&m[e][8 * block + kW * p]);
+    const double floor = std::min(lower, enough);
+    if (floor > 0 && floor < 1) {
+      bool all = true;
+      for (int p = 0; p < kParts && all; ++p) all = mask_bits<kW>(ratio_at_least<kW>(mb[p], err, floor)) == kAll;
+      if (all) {
+        lower = floor;
+        continue;
+      }
+    }
+    for (int p = 0; p < kParts; ++p) {
+      const ExtremeEigen<kW> eig = extreme_eigen<kW>(mb[p], broadcast_lanes<kW>(err));
+      if (mask_bits<kW>(eig.ok & (eig.lo > 0)) != kAll) return 0;
+      lower = fold_min(down<kW>(eig.lo / eig.hi), lower);
+    }
+  }
+  return std::clamp(lower, 0.0, 1.0);
+}
+
 }  // namespace
 
 CertifiedRatio trilinear_hex_ratio(std::span<const double> x) {
@@ -201,9 +279,18 @@ RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRati
   thread_local std::vector<std::pair<double, int>> heap;
   const auto later = [](const std::pair<double, int>& p, const std::pair<double, int>& q) { return p > q; };
   pool.resize(1);
-  pool[0].delta = element_columns(x, pool[0].w);
-  pool[0].ratio = root;
-  pool[0].depth = 0;
+  Box& whole = pool[0];
+  whole.delta = element_columns(x, whole.w);
+  whole.lower = root.lower;
+  whole.depth = 0;
+  // The root's corner ratios (trilinear_hex_ratio took its upper bound from them already).
+  {
+    const double err = entry_error(largest_entry(whole.w), whole.delta);
+    constexpr int kLow[4] = {0, 1, 2, 3}, kHigh[4] = {4, 5, 6, 7};
+    if (!corner_ratios(whole.w, kLow, err, whole.delta, whole.corner, nullptr) ||
+        !corner_ratios(whole.w, kHigh, err, whole.delta, whole.corner + 4, nullptr))
+      return {};
+  }
   heap.assign(1, {root.lower, 0});
   RefinedRatio out;
   out.ratio = root;
@@ -214,17 +301,31 @@ RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRati
     heap.pop_back();
     const Box top = pool[static_cast<std::size_t>(slot)];
     pool.emplace_back();
-    const int slots[2] = {slot, static_cast<int>(pool.size() - 1)};
-    halve(top, top.depth % 3, pool[static_cast<std::size_t>(slots[0])], pool.back());
+    Box& low = pool[static_cast<std::size_t>(slot)];
+    Box& high = pool.back();
+    const int d = top.depth % 3;
+    halve(top, d, low, high);
     ++out.halvings;
-    for (const int s : slots) {
-      Box& child = pool[static_cast<std::size_t>(s)];
-      child.ratio = box_ratio(child.w, child.delta, enough(out.ratio.upper));
-      if (!child.ratio.ok) return {};
+    // Each half keeps 4 of its parent's corners; the other 4, on the plane between them,
+    // are the same for both (low's with bit d set, high's with it clear): enclosed once.
+    int plane[4], n = 0;
+    for (int q = 0; q < 8; ++q)
+      if ((q & (1 << d)) != 0) plane[n++] = q;
+    double mid[4];
+    const double err = entry_error(std::max(largest_entry(low.w), largest_entry(high.w)), low.delta);
+    if (!corner_ratios(low.w, plane, err, low.delta, mid, &out.ratio.upper)) return {};
+    for (int i = 0; i < 4; ++i) {
+      const int q1 = plane[i], q0 = q1 & ~(1 << d);
+      low.corner[q0] = top.corner[q0];
+      low.corner[q1] = mid[i];
+      high.corner[q0] = mid[i];
+      high.corner[q1] = top.corner[q1];
+    }
+    const double target = enough(out.ratio.upper);
+    for (Box* half : {&low, &high}) {
       // The parent's bound holds on its halves too.
-      child.ratio.lower = std::max(child.ratio.lower, top.ratio.lower);
-      out.ratio.upper = std::min(out.ratio.upper, child.ratio.upper);
-      heap.emplace_back(child.ratio.lower, s);
+      half->lower = std::max(box_lower(*half, target), top.lower);
+      heap.emplace_back(half->lower, static_cast<int>(half - pool.data()));
       std::push_heap(heap.begin(), heap.end(), later);
     }
   }

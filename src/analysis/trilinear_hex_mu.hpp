@@ -47,8 +47,11 @@ struct RefinedRatio {
 /// values by de Casteljau at 1/2, their rounding added to their error bound). Each half
 /// keeps its parent's lower bound where that is higher; the upper bound is the least over
 /// every box's corners. A half's control matrices are certified only down to what settles
-/// the element (the general path's r_target), most by the cheap test alone. The general
-/// path refines the same way with its own products and one eigen solve per corner.
+/// the element (the general path's r_target), most by the cheap test alone. The two halves
+/// share the 4 corners of the plane between them and each keeps 4 of its parent's, so a
+/// halving encloses 4 corner metrics, not 16 (hex_box_N20 mu, 1 thread, 11 alternating CLI
+/// runs: 28.2 -> 24.4 ms). The general path refines the same way with its own products and
+/// one eigen solve per corner.
 RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRatio root, double abs_tol,
                                         int max_halvings);
 
