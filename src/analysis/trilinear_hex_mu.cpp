@@ -34,6 +34,7 @@ constexpr int kCross[3][2] = {{0, 1}, {0, 2}, {1, 2}};  // entries m01, m02, m12
 
 struct Layout {
   std::array<int, kSlots> point{};
+  std::array<int, kPoints> slot{};  // point -> its slot
   std::array<std::array<std::uint8_t, kSlots>, 3> diagonal_source{};  // b + 3 c (along x + 1, x + 2)
   std::array<std::array<std::uint8_t, kSlots>, 3> cross_source{};     // 9 a + 3 b + c (along x, y, z)
 };
@@ -46,6 +47,7 @@ Layout make_layout() {
   for (int p = 0; p < kPoints; ++p)
     if (!is_corner(p)) l.point[static_cast<std::size_t>(s++)] = p;
   QV_ASSERT(s == kPoints, s << " control points");
+  for (int t = 0; t < kPoints; ++t) l.slot[static_cast<std::size_t>(l.point[static_cast<std::size_t>(t)])] = t;
   for (; s < kSlots; ++s) l.point[static_cast<std::size_t>(s)] = l.point[0];
   for (int t = 0; t < kSlots; ++t) {
     const int p = l.point[static_cast<std::size_t>(t)];
@@ -130,11 +132,15 @@ CertifiedRatio box_ratio(const double (*w)[8][3], double delta, double enough = 
   return control_matrix_ratio(m, kSlots, 8, w, err, delta, enough);
 }
 
-// A box of the reference cube: J's columns' control values on it, their error bound, the
-// certified lower bound of R at each of its corners, and its lower bound of R.
+// A box of the reference cube: J's columns' control values on it (for the corners' Rayleigh
+// quotients), their error bound, M's control values by slot (Layout: the corners first; the
+// spare slots repeat slot 8, the first other point), their error bound, the certified lower
+// bound of R at each of its corners, and its lower bound of R.
 struct Box {
   double w[3][8][3];
   double delta;
+  alignas(64) double m[6][kSlots];
+  double err;
   double corner[8];
   double lower;
   int depth;  // halvings from the root; the next one is along direction depth % 3
@@ -190,33 +196,79 @@ double entry_error(double a, double delta) {
   return next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
 }
 
-// The metrics at 4 corners qs of a box (W's values there, each entry within err), in lanes:
-// each one's certified lower bound of R into ratio[i], and with `upper` set, its Rayleigh
-// quotients' upper bound of R folded into *upper. The corner values are the products
-// box_ratio takes at slots 0-7 (one pair each), so their bits are the same. false where a
-// metric is not certified positive definite.
-bool corner_ratios(const double (*w)[8][3], const int* qs, double err, double delta, double* ratio, double* upper) {
+// The metrics at 4 corners qs of a box (M's control values there, which are its values,
+// each entry within box.err), in lanes: each one's certified lower bound of R into
+// ratio[i], and with `upper` set, the upper bound of R from Rayleigh quotients of W there
+// folded into *upper. false where a metric is not certified positive definite.
+bool corner_ratios(const Box& box, const int* qs, double* ratio, double* upper) {
   constexpr int kW = kNativeLanes;
-  if (!(err < kMax)) return false;
+  if (!(box.err < kMax)) return false;
   for (int part = 0; part < 4 / kW; ++part) {
     Lanes<kW> m[6], wv[3][3];
     for (int l = 0; l < kW; ++l) {
       const int q = qs[kW * part + l];
-      for (int x = 0; x < 3; ++x) m[x][l] = dot(w[x][q], w[x][q]);
-      for (int e = 0; e < 3; ++e) m[3 + e][l] = dot(w[kCross[e][0]][q], w[kCross[e][1]][q]);
+      for (int e = 0; e < 6; ++e) m[e][l] = box.m[e][q];
       for (int j = 0; j < 3; ++j)
-        for (int c = 0; c < 3; ++c) wv[j][c][l] = w[j][q][c];
+        for (int c = 0; c < 3; ++c) wv[j][c][l] = box.w[j][q][c];
     }
-    const ExtremeEigen<kW> eig = extreme_eigen<kW>(m, broadcast_lanes<kW>(err));
+    const ExtremeEigen<kW> eig = extreme_eigen<kW>(m, broadcast_lanes<kW>(box.err));
     if (mask_bits<kW>(eig.ok & (eig.lo > 0)) != (1u << kW) - 1) return false;
     const Lanes<kW> r = down<kW>(eig.lo / eig.hi);
     for (int l = 0; l < kW; ++l) ratio[kW * part + l] = r[l];
     if (upper == nullptr) continue;
     Mask<kW> vectors_ok;
-    const Lanes<kW> u = ratio_upper<kW>(wv, m, eig.lo, eig.hi, broadcast_lanes<kW>(delta), vectors_ok);
+    const Lanes<kW> u = ratio_upper<kW>(wv, m, eig.lo, eig.hi, broadcast_lanes<kW>(box.delta), vectors_ok);
     for (int l = 0; l < kW; ++l) *upper = std::min(*upper, u[l]);
   }
   return true;
+}
+
+// The spare slots of m repeat slot 8.
+void fill_spare_slots(double (*m)[kSlots]) {
+  for (int e = 0; e < 6; ++e)
+    for (int t = kPoints; t < kSlots; ++t) m[e][t] = m[e][8];
+}
+
+// M's control values on the whole element, as box_ratio computes them.
+void root_metric(Box& box) {
+  const Layout& lay = layout();
+  for (int x = 0; x < 3; ++x) diagonal_entry(box.w[x], x, lay, box.m[x]);
+  for (int e = 0; e < 3; ++e) cross_entry(box.w, e, lay, box.m[3 + e]);
+  fill_spare_slots(box.m);
+  box.err = entry_error(largest_entry(box.w), box.delta);
+}
+
+// M's control values on the two halves of `box` along d, by de Casteljau at 1/2 along d
+// (M has degree 2 there: (a, b, c) -> (a, (a + b)/2, q) and (q, (b + c)/2, c), q the mean
+// of the two middle values). The map is a convex combination, so the parent's error bound
+// carries over; the averages round twice (the halvings are exact), within 2u of the
+// largest |value| (a smallest subnormal added for underflow).
+void halve_metric(const Box& box, int d, Box& low, Box& high) {
+  constexpr int kStride[3] = {1, 3, 9};
+  const auto& slot = layout().slot;
+  const int stride = kStride[d], s1 = kStride[(d + 1) % 3], s2 = kStride[(d + 2) % 3];
+  double largest = 0;
+  for (int line = 0; line < 9; ++line) {  // the line along d from each point with index 0
+    const int p = s1 * (line % 3) + s2 * (line / 3);
+    const auto t0 = static_cast<std::size_t>(slot[static_cast<std::size_t>(p)]);
+    const auto t1 = static_cast<std::size_t>(slot[static_cast<std::size_t>(p + stride)]);
+    const auto t2 = static_cast<std::size_t>(slot[static_cast<std::size_t>(p + 2 * stride)]);
+    for (int e = 0; e < 6; ++e) {
+      const double a = box.m[e][t0], b = box.m[e][t1], c = box.m[e][t2];
+      const double ab = 0.5 * (a + b), bc = 0.5 * (b + c), mid = 0.5 * (ab + bc);
+      largest = std::max({largest, std::abs(a), std::abs(b), std::abs(c)});
+      low.m[e][t0] = a;
+      low.m[e][t1] = ab;
+      low.m[e][t2] = mid;
+      high.m[e][t0] = mid;
+      high.m[e][t1] = bc;
+      high.m[e][t2] = c;
+    }
+  }
+  fill_spare_slots(low.m);
+  fill_spare_slots(high.m);
+  low.err = high.err =
+      next_up((box.err + 2 * kUnit * largest) * kSlack + std::numeric_limits<double>::denorm_min());
 }
 
 // The lower bound of R on a box whose corners' ratios are known: the least of those and of
@@ -224,29 +276,24 @@ bool corner_ratios(const double (*w)[8][3], const int* qs, double err, double de
 // min(lower so far, enough) first, an enclosure where it fails; 0 where a matrix is not
 // certified positive definite).
 double box_lower(const Box& box, double enough) {
-  const Layout& lay = layout();
-  const double err = entry_error(largest_entry(box.w), box.delta);
-  alignas(64) double m[6][kSlots];
-  for (int x = 0; x < 3; ++x) diagonal_entry(box.w[x], x, lay, m[x]);
-  for (int e = 0; e < 3; ++e) cross_entry(box.w, e, lay, m[3 + e]);
   constexpr int kW = kNativeLanes, kParts = 8 / kW;
   constexpr unsigned kAll = (1u << kW) - 1;
   double lower = *std::min_element(box.corner, box.corner + 8);
   for (int block = 1; block < kSlots / 8; ++block) {
     Lanes<kW> mb[kParts][6];
     for (int p = 0; p < kParts; ++p)
-      for (int e = 0; e < 6; ++e) mb[p][e] = load_lanes<kW>(&m[e][8 * block + kW * p]);
+      for (int e = 0; e < 6; ++e) mb[p][e] = load_lanes<kW>(&box.m[e][8 * block + kW * p]);
     const double floor = std::min(lower, enough);
     if (floor > 0 && floor < 1) {
       bool all = true;
-      for (int p = 0; p < kParts && all; ++p) all = mask_bits<kW>(ratio_at_least<kW>(mb[p], err, floor)) == kAll;
+      for (int p = 0; p < kParts && all; ++p) all = mask_bits<kW>(ratio_at_least<kW>(mb[p], box.err, floor)) == kAll;
       if (all) {
         lower = floor;
         continue;
       }
     }
     for (int p = 0; p < kParts; ++p) {
-      const ExtremeEigen<kW> eig = extreme_eigen<kW>(mb[p], broadcast_lanes<kW>(err));
+      const ExtremeEigen<kW> eig = extreme_eigen<kW>(mb[p], broadcast_lanes<kW>(box.err));
       if (mask_bits<kW>(eig.ok & (eig.lo > 0)) != kAll) return 0;
       lower = fold_min(down<kW>(eig.lo / eig.hi), lower);
     }
@@ -283,12 +330,11 @@ RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRati
   whole.delta = element_columns(x, whole.w);
   whole.lower = root.lower;
   whole.depth = 0;
+  root_metric(whole);
   // The root's corner ratios (trilinear_hex_ratio took its upper bound from them already).
   {
-    const double err = entry_error(largest_entry(whole.w), whole.delta);
     constexpr int kLow[4] = {0, 1, 2, 3}, kHigh[4] = {4, 5, 6, 7};
-    if (!corner_ratios(whole.w, kLow, err, whole.delta, whole.corner, nullptr) ||
-        !corner_ratios(whole.w, kHigh, err, whole.delta, whole.corner + 4, nullptr))
+    if (!corner_ratios(whole, kLow, whole.corner, nullptr) || !corner_ratios(whole, kHigh, whole.corner + 4, nullptr))
       return {};
   }
   heap.assign(1, {root.lower, 0});
@@ -305,6 +351,7 @@ RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRati
     Box& high = pool.back();
     const int d = top.depth % 3;
     halve(top, d, low, high);
+    halve_metric(top, d, low, high);
     ++out.halvings;
     // Each half keeps 4 of its parent's corners; the other 4, on the plane between them,
     // are the same for both (low's with bit d set, high's with it clear): enclosed once.
@@ -312,8 +359,7 @@ RefinedRatio refine_trilinear_hex_ratio(std::span<const double> x, CertifiedRati
     for (int q = 0; q < 8; ++q)
       if ((q & (1 << d)) != 0) plane[n++] = q;
     double mid[4];
-    const double err = entry_error(std::max(largest_entry(low.w), largest_entry(high.w)), low.delta);
-    if (!corner_ratios(low.w, plane, err, low.delta, mid, &out.ratio.upper)) return {};
+    if (!corner_ratios(low, plane, mid, &out.ratio.upper)) return {};
     for (int i = 0; i < 4; ++i) {
       const int q1 = plane[i], q0 = q1 & ~(1 << d);
       low.corner[q0] = top.corner[q0];
