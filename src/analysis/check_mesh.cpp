@@ -30,6 +30,7 @@
 #include "analysis/bilinear_quad_quality.hpp"
 #include "analysis/check_summary.hpp"
 #include "analysis/linear_jacobian.hpp"
+#include "analysis/linear_pyramid_mu.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/mu_constant.hpp"
 #include "analysis/mu_space.hpp"
@@ -485,6 +486,26 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
+            // mu of a first-order chunk's valid pyramids with a parallelogram base (W
+            // constant), W = kNativeLanes at a time (linear_pyramid_mu.hpp), into lane_mu as
+            // straight_lanes_of below; their scaled Jacobian goes element by element.
+            const auto pyramid_lanes_of = [&](const ElementType& t, std::size_t count) {
+              lane_mu.resize(kLinearChunk);
+              constexpr std::size_t kW = kNativeLanes;
+              for (std::size_t i0 = 0; i0 < count; i0 += kW) {
+                Lanes<kW> x[15];
+                unsigned valid = 0;
+                for (std::size_t l = 0; l < kW; ++l) {
+                  const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
+                  for (std::size_t v = 0; v < 15; ++v) x[v][l] = soa[v * kLinearRow + i];
+                  if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid) valid |= 1u << l;
+                }
+                lane_mu_done[i0 / kW] = valid == 0 || !mu_supported(t)
+                                            ? 0u
+                                            : valid & linear_pyramid_mu_lanes(t, x, qo.abs_tol, lane_mu.data() + i0);
+                lane_straight_sj_done[i0 / kW] = 0;
+              }
+            };
             // mu and the scaled Jacobian of a chunk's valid straight-sided tetrahedra, planar
             // triangles and planar bilinear quadrangles (decided by linear_validity_chunk,
             // vertices in `soa` by vertex and axis, rows of `row`, z not read in 2D; betas
@@ -498,6 +519,10 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                                                const double* js, std::size_t count) {
               const bool tet = t.family == ElementFamily::tetrahedron;
               const bool quad = t.family == ElementFamily::quadrangle;
+              if (t.family == ElementFamily::pyramid) {  // first order only (straight_lanes_for)
+                pyramid_lanes_of(t, count);
+                return;
+              }
               const bool lane_mu_wanted = want_mu && mu_supported(t) && (!quad || mu_constant_path_enabled());
               const bool lane_sj_wanted =
                   want_sj && scaled_jacobian_supported(t) && (!quad || scaled_jacobian_straight_path_enabled());
@@ -539,8 +564,9 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
             // Whether a chunk of that first-order kind (or straight-sided elements of it) has
             // results in straight_lanes_of's lanes.
             const auto straight_lanes_for = [&](LinearKind kind) {
-              return (want_mu || want_sj) && (kind == LinearKind::tetrahedron || kind == LinearKind::triangle ||
-                                               kind == LinearKind::quadrangle);
+              return ((want_mu || want_sj) && (kind == LinearKind::tetrahedron || kind == LinearKind::triangle ||
+                                                kind == LinearKind::quadrangle)) ||
+                     (want_mu && kind == LinearKind::pyramid);
             };
             const auto lane_of = [&](const unsigned* done, std::vector<QualityBounds>& lane, std::size_t i) {
               return ((done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane[i] : nullptr;

@@ -36,4 +36,22 @@ namespace quadval {
 /// @param jinv  the ideal pyramid's inverse Jacobian (MuSpace::ideal_inverse)
 CertifiedRatio linear_pyramid_ratio(std::span<const double> x, const std::array<double, 9>& jinv);
 
+/// The closed form of linear_pyramid_ratio for a constant W (a parallelogram base: d = 0
+/// above), one pyramid per lane, x[3 n + k] node n's coordinate k (constant_columns_ratio,
+/// vertex_metric_ratio.hpp): bit l of ok set where lane l's pyramid has a constant W and
+/// the closed form succeeded; then linear_pyramid_ratio returns these bounds (ok where
+/// lower <= upper).
+StraightSimplexRatio<kNativeLanes> linear_pyramid_constant_ratio(const Lanes<kNativeLanes>* x,
+                                                                 const std::array<double, 9>& jinv);
+
+struct QualityBounds;
+struct ElementType;
+
+/// mu of kNativeLanes valid first-order pyramids of `type` (x as above), each as
+/// mu_bounds_given computes it (bit-identical) where bit l of the result is set; the other
+/// lanes need mu_bounds_given (W not constant, a failed step, bounds wider than tol).
+/// Nothing while mu_use_constant_path(false). Defined in mu_bounds.cpp.
+unsigned linear_pyramid_mu_lanes(const ElementType& type, const Lanes<kNativeLanes>* x, double tol,
+                                 QualityBounds* out);
+
 }  // namespace quadval

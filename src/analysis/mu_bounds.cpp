@@ -231,6 +231,20 @@ unsigned straight_simplex_mu_lanes(const ElementType& type, const Lanes<kNativeL
   return done;
 }
 
+unsigned linear_pyramid_mu_lanes(const ElementType& type, const Lanes<kNativeLanes>* x, double tol,
+                                 QualityBounds* out) {
+  if (!mu_constant_path_enabled()) return 0;
+  const StraightSimplexRatio<kNativeLanes> r = linear_pyramid_constant_ratio(x, mu_space(type).ideal_inverse());
+  unsigned done = 0;
+  for (int l = 0; l < kNativeLanes; ++l)
+    if (((r.ok >> l) & 1u) != 0 && r.lower[l] <= r.upper[l])
+      if (const auto mu = mu_from_ratio(r.lower[l], r.upper[l], tol)) {
+        out[l] = *mu;
+        done |= 1u << l;
+      }
+  return done;
+}
+
 bool mu_supported(const ElementType& type) noexcept {
   return handled_family(type.family) && type.has_lagrange_basis && type.order >= 1 &&
          type.order <= mu_max_order(type.family) && jacobian_bounds_supported(type);

@@ -113,32 +113,53 @@ CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], i
   return out;
 }
 
+template <int W>
+StraightSimplexRatio<W> constant_columns_ratio(const Lanes<W> (*col)[8][3], int vertices, const Lanes<W>* rounding,
+                                               const std::array<double, 9>& jinv) {
+  using L = Lanes<W>;
+  L scale{}, spread{}, edges[9], margins[3];
+  for (int c = 0; c < 3; ++c) {
+    L beta{};
+    for (int q = 0; q < vertices; ++q)
+      for (int k = 0; k < 3; ++k) {
+        scale = vmax(scale, vabs(col[c][q][k]));
+        if (q > 0) beta = vmax(beta, vabs(col[c][q][k] - col[c][0][k]));
+      }
+    spread = vmax(spread, beta);
+    margins[c] = lanes3::up<W>((beta + rounding[c]) * lanes3::kSlack);
+    for (int k = 0; k < 3; ++k) edges[3 * c + k] = col[c][0][k];
+  }
+  StraightSimplexRatio<W> r = straight_tet_ratio<W>(edges, margins, jinv);
+  r.ok &= lanes3::mask_bits<W>(spread <= 1e-9 * scale);
+  return r;
+}
+
+template StraightSimplexRatio<2> constant_columns_ratio<2>(const Lanes<2> (*)[8][3], int, const Lanes<2>*,
+                                                           const std::array<double, 9>&);
+template StraightSimplexRatio<kNativeLanes> constant_columns_ratio<kNativeLanes>(const Lanes<kNativeLanes> (*)[8][3],
+                                                                                 int, const Lanes<kNativeLanes>*,
+                                                                                 const std::array<double, 9>&);
+
 CertifiedRatio columns_ratio(const VertexProducts& domain, const double (*col)[8][3], const double* rounding,
                              const std::array<double, 9>& jinv) {
   constexpr double kUnit = 0x1p-53;
   constexpr double kSlack = lanes3::kSlack;
   const int nv = domain.vertices;
-  double a[3] = {0, 0, 0}, scale = 0;  // per column, its largest |entry|
-  for (int c = 0; c < 3; ++c) {
-    for (int q = 0; q < nv; ++q)
-      for (int k = 0; k < 3; ++k) a[c] = std::max(a[c], std::abs(col[c][q][k]));
-    scale = std::max(scale, a[c]);
-  }
-  // Constant W: the closed form, two lanes (as one tetrahedron in mu_bounds).
-  Lanes<2> edges[9], margins[3];
-  double spread = 0;
-  for (int c = 0; c < 3; ++c) {
-    double beta = 0;
-    for (int q = 1; q < nv; ++q)
-      for (int k = 0; k < 3; ++k) beta = std::max(beta, std::abs(col[c][q][k] - col[c][0][k]));
-    spread = std::max(spread, beta);
-    margins[c] = broadcast_lanes<2>(next_up((beta + rounding[c]) * kSlack));
-    for (int k = 0; k < 3; ++k) edges[3 * c + k] = broadcast_lanes<2>(col[c][0][k]);
-  }
-  if (spread <= 1e-9 * scale) {
-    const StraightSimplexRatio<2> r = straight_tet_ratio<2>(edges, margins, jinv);
+  // Constant W: the closed form, the element in both lanes (as one tetrahedron in mu_bounds).
+  {
+    Lanes<2> lanes[3][8][3], round[3];
+    for (int c = 0; c < 3; ++c) {
+      round[c] = broadcast_lanes<2>(rounding[c]);
+      for (int q = 0; q < nv; ++q)
+        for (int k = 0; k < 3; ++k) lanes[c][q][k] = broadcast_lanes<2>(col[c][q][k]);
+    }
+    const StraightSimplexRatio<2> r = constant_columns_ratio<2>(lanes, nv, round, jinv);
     if ((r.ok & 1u) != 0) return {r.lower[0], r.upper[0], r.lower[0] <= r.upper[0]};
   }
+  double a[3] = {0, 0, 0};  // per column, its largest |entry|
+  for (int c = 0; c < 3; ++c)
+    for (int q = 0; q < nv; ++q)
+      for (int k = 0; k < 3; ++k) a[c] = std::max(a[c], std::abs(col[c][q][k]));
   double w[3][8][3] = {};
   double delta = 0, b = 0;
   for (int j = 0; j < 3; ++j) {

@@ -19,6 +19,8 @@
 // entry errors 3 (2 b + delta) delta.
 #include <array>
 
+#include "analysis/lane_vector.hpp"
+#include "analysis/straight_simplex_mu.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval {
@@ -87,6 +89,19 @@ CertifiedRatio vertex_metric_ratio(const VertexProducts& domain, const double (*
 /// the cheap test alone proves that.
 CertifiedRatio control_matrix_ratio(const double (*m)[VertexProducts::kSlots], int slots, int vertices,
                                     const double (*w)[8][3], double err, double delta, double enough = 1);
+
+/// columns_ratio's closed form for a constant W, one element per lane (col[c][q][k]: its
+/// column c at vertex q < vertices, coordinate k; rounding[c] as columns_ratio's): bit l of
+/// ok is set where lane l's columns agree at every vertex to 1e-9 of their largest entry and
+/// the closed form succeeds; its bounds are then those of columns_ratio, which takes them
+/// from here (the element in both lanes of W = 2) where also lower <= upper.
+template <int W>
+StraightSimplexRatio<W> constant_columns_ratio(const Lanes<W> (*col)[8][3], int vertices, const Lanes<W>* rounding,
+                                               const std::array<double, 9>& jinv);
+extern template StraightSimplexRatio<2> constant_columns_ratio<2>(const Lanes<2> (*)[8][3], int, const Lanes<2>*,
+                                                                  const std::array<double, 9>&);
+extern template StraightSimplexRatio<kNativeLanes> constant_columns_ratio<kNativeLanes>(
+    const Lanes<kNativeLanes> (*)[8][3], int, const Lanes<kNativeLanes>*, const std::array<double, 9>&);
 
 /// R's bounds for W = J Jinv (any common scale of J), from J's columns' control values at
 /// the vertices, col[c][q][k], each entry within rounding[c] of the exact one. Where the

@@ -12,7 +12,9 @@
 
 #include "analysis/linear_pyramid_mu.hpp"
 #include "analysis/mu_space.hpp"
+#include "check_alone_test_util.hpp"
 #include "first_order_mu_test_util.hpp"
+#include "quadval/mu_bounds.hpp"
 
 namespace quadval {
 namespace {
@@ -106,6 +108,36 @@ TEST(LinearPyramidMu, AgreesWithTheGeneralPath) {
   std::mt19937 rng(53);
   test::check_against_general_path(
       pyramid5(), [](int e, std::mt19937& r) { return random_pyramid(e, e % 2 == 0 ? 0.05 : 0.2, r); }, 300, 100, rng);
+}
+
+// The check computes mu of first-order pyramids with a parallelogram base four at a time
+// (linear_pyramid_mu_lanes): every element gets the bits mu_bounds gives it alone, whether
+// its neighbours in the lanes have a constant W, a general one, or are inverted.
+TEST(LinearPyramidMu, CheckChunksMatchEachElementAloneBitForBit) {
+  std::mt19937 rng(61);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const ElementType& t = pyramid5();
+  std::vector<std::vector<double>> elements;
+  int parallelograms = 0;
+  for (int e = 0; e < 1200; ++e) {
+    if (e % 3 == 2) {
+      elements.push_back(random_pyramid(e, e % 2 == 0 ? 0.05 : 0.3, rng));
+      continue;
+    }
+    Eigen::Matrix3d a;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) a(i, j) = (i == j ? 1.0 : 0.0) + 0.4 * u(rng);
+    if (e % 17 == 0) a.col(2) *= -1;  // inverted
+    std::vector<double> x = test::affine_ideal_element(t, a, Eigen::Vector3d(u(rng), u(rng), 5 * u(rng)));
+    for (int k = 0; k < 3; ++k) x[static_cast<std::size_t>(12 + k)] += 0.2 * u(rng);  // the apex anywhere
+    elements.push_back(x);
+    ++parallelograms;
+  }
+  EXPECT_GT(parallelograms, 700);
+  EXPECT_GT(test::expect_check_matches_alone(
+                t, elements, CheckMeasure::mu,
+                [&](const std::vector<double>& x, const QualityOptions& q) { return mu_bounds(t, x, q, false); }),
+            900);
 }
 
 }  // namespace
