@@ -371,7 +371,19 @@ double control_ratio_lower3(const double* const* entries, double e, int size, do
   int first = -1;
   if (size > 1 && enough >= 1) {
     double least = kInf;
-    for (int k = 0; k < size; ++k) {
+    int k = 0;
+    for (; k + kW <= size; k += kW) {  // ratio_estimate3 kW at a time: the same values
+      LW a[6];
+      for (int i = 0; i < 6; ++i) a[i] = load_lanes<kW>(entries[i] + k);
+      const LW t = (a[0] + a[1] + a[2]) / 3;
+      const LW det = a[0] * (a[1] * a[2] - a[5] * a[5]) - a[3] * (a[3] * a[2] - a[5] * a[4]) +
+                     a[4] * (a[3] * a[5] - a[1] * a[4]);
+      const LW ratio = det / (t * t * t);
+      const LW est = (t > 0) & lanes3::finite<kW>(ratio) ? ratio : LW{} - 1.0;
+      for (int l = 0; l < kW; ++l)
+        if (est[l] < least) least = est[l], first = k + l;
+    }
+    for (; k < size; ++k) {
       load(k);
       const double est = ratio_estimate3(m);
       if (est < least) least = est, first = k;
