@@ -114,15 +114,25 @@ void cross_entry(const double (*w)[8][3], int e, const Layout& lay, double* out)
   for (int t = 0; t < kSlots; ++t) out[t] = raised[source[static_cast<std::size_t>(t)]];
 }
 
-// R's bounds on a box whose columns' control values w (column, vertex, coordinate) are
-// within delta of the exact ones.
-CertifiedRatio box_ratio(const double (*w)[8][3], double delta, double enough = 1) {
-  const Layout& lay = layout();
+double largest_entry(const double (*w)[8][3]) {
   double a = 0;
   for (int c = 0; c < 3; ++c)
     for (int q = 0; q < 8; ++q)
       for (int k = 0; k < 3; ++k) a = std::max(a, std::abs(w[c][q][k]));
-  const double err = next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
+  return a;
+}
+
+// The bound on every control value's error (see the header).
+double entry_error(double a, double delta) {
+  return next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
+}
+
+// R's bounds on a box whose columns' control values w (column, vertex, coordinate) are
+// within delta of the exact ones.
+CertifiedRatio box_ratio(const double (*w)[8][3], double delta, double enough = 1) {
+  const Layout& lay = layout();
+  const double a = largest_entry(w);
+  const double err = entry_error(a, delta);
   if (!(err < kMax) || !(a > 0)) return {};
   // The control values of M's entries m00, m11, m22, m01, m02, m12, by slot.
   alignas(64) double m[6][kSlots];
@@ -181,19 +191,6 @@ void halve(const Box& box, int d, Box& low, Box& high) {
     }
   low.delta = high.delta = next_up((box.delta + kUnit * a) * kSlack + std::numeric_limits<double>::denorm_min());
   low.depth = high.depth = box.depth + 1;
-}
-
-double largest_entry(const double (*w)[8][3]) {
-  double a = 0;
-  for (int c = 0; c < 3; ++c)
-    for (int q = 0; q < 8; ++q)
-      for (int k = 0; k < 3; ++k) a = std::max(a, std::abs(w[c][q][k]));
-  return a;
-}
-
-// The bound on every control value's error (see the header), as box_ratio takes it.
-double entry_error(double a, double delta) {
-  return next_up((3 * (2 * a + delta) * delta + rounding_gamma(10) * 3 * a * a) * kSlack);
 }
 
 // The metrics at 4 corners qs of a box (M's control values there, which are its values,
