@@ -31,6 +31,8 @@
 #include "analysis/check_summary.hpp"
 #include "analysis/linear_jacobian.hpp"
 #include "analysis/linear_pyramid_mu.hpp"
+#include "analysis/linear_pyramid_sj.hpp"
+#include "analysis/trilinear_hex_sj.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/mu_constant.hpp"
 #include "analysis/mu_space.hpp"
@@ -487,10 +489,14 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               st.add(b.stage, b.validity, ticks);
             };
             // mu of a first-order chunk's valid pyramids with a parallelogram base (W
-            // constant), W = kNativeLanes at a time (linear_pyramid_mu.hpp), into lane_mu as
-            // straight_lanes_of below; their scaled Jacobian goes element by element.
+            // constant; linear_pyramid_mu.hpp) and the scaled Jacobian's root bound of all of
+            // its valid pyramids (linear_pyramid_sj.hpp), W = kNativeLanes at a time, into
+            // lane_mu and lane_straight_sj as straight_lanes_of below.
             const auto pyramid_lanes_of = [&](const ElementType& t, std::size_t count) {
               lane_mu.resize(kLinearChunk);
+              lane_straight_sj.resize(kLinearChunk);
+              const bool mu_wanted = want_mu && mu_supported(t);
+              const bool sj_wanted = want_sj && scaled_jacobian_supported(t) && scaled_jacobian_straight_path_enabled();
               constexpr std::size_t kW = kNativeLanes;
               for (std::size_t i0 = 0; i0 < count; i0 += kW) {
                 Lanes<kW> x[15];
@@ -500,10 +506,34 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   for (std::size_t v = 0; v < 15; ++v) x[v][l] = soa[v * kLinearRow + i];
                   if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid) valid |= 1u << l;
                 }
-                lane_mu_done[i0 / kW] = valid == 0 || !mu_supported(t)
+                lane_mu_done[i0 / kW] = valid == 0 || !mu_wanted
                                             ? 0u
                                             : valid & linear_pyramid_mu_lanes(t, x, qo.abs_tol, lane_mu.data() + i0);
-                lane_straight_sj_done[i0 / kW] = 0;
+                lane_straight_sj_done[i0 / kW] =
+                    valid == 0 || !sj_wanted ? 0u
+                                             : valid & linear_pyramid_sj_lanes(scaled_jacobian_space(t), x, qo.abs_tol,
+                                                                              lane_straight_sj.data() + i0);
+              }
+            };
+            // The scaled Jacobian of a first-order chunk's valid hexahedra, W = kNativeLanes at a
+            // time (trilinear_hex_sj.hpp), into lane_straight_sj as straight_lanes_of below;
+            // their mu goes element by element.
+            const auto hexahedron_lanes_of = [&](const ElementType& t, std::size_t count) {
+              lane_straight_sj.resize(kLinearChunk);
+              constexpr std::size_t kW = kNativeLanes;
+              const bool wanted = scaled_jacobian_supported(t) && scaled_jacobian_straight_path_enabled();
+              for (std::size_t i0 = 0; i0 < count; i0 += kW) {
+                Lanes<kW> x[24];
+                unsigned valid = 0;
+                for (std::size_t l = 0; l < kW; ++l) {
+                  const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
+                  for (std::size_t v = 0; v < 24; ++v) x[v][l] = soa[v * kLinearRow + i];
+                  if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid) valid |= 1u << l;
+                }
+                lane_straight_sj_done[i0 / kW] =
+                    valid == 0 || !wanted ? 0u
+                                          : valid & trilinear_hex_sj_lanes(x, qo.abs_tol, lane_straight_sj.data() + i0);
+                lane_mu_done[i0 / kW] = 0;
               }
             };
             // mu and the scaled Jacobian of a chunk's valid straight-sided tetrahedra, planar
@@ -519,8 +549,12 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                                                const double* js, std::size_t count) {
               const bool tet = t.family == ElementFamily::tetrahedron;
               const bool quad = t.family == ElementFamily::quadrangle;
-              if (t.family == ElementFamily::pyramid) {  // first order only (straight_lanes_for)
+              if (t.family == ElementFamily::pyramid) {  // order 1 only (straight_lanes_for)
                 pyramid_lanes_of(t, count);
+                return;
+              }
+              if (t.family == ElementFamily::hexahedron) {  // likewise
+                hexahedron_lanes_of(t, count);
                 return;
               }
               const bool lane_mu_wanted = want_mu && mu_supported(t) && (!quad || mu_constant_path_enabled());
@@ -561,12 +595,14 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                            : valid & straight_simplex_sj_lanes(t, edges, margin, j_margin, qo.abs_tol, sj_out);
               }
             };
-            // Whether a chunk of that first-order kind (or straight-sided elements of it) has
-            // results in straight_lanes_of's lanes.
-            const auto straight_lanes_for = [&](LinearKind kind) {
+            // Whether a chunk of that first-order kind (or, first_order false, straight-sided
+            // elements of it) has results in straight_lanes_of's lanes: pyramids and
+            // hexahedra only at order 1.
+            const auto straight_lanes_for = [&](LinearKind kind, bool first_order) {
               return ((want_mu || want_sj) && (kind == LinearKind::tetrahedron || kind == LinearKind::triangle ||
                                                 kind == LinearKind::quadrangle)) ||
-                     (want_mu && kind == LinearKind::pyramid);
+                     (first_order && (want_mu || want_sj) && kind == LinearKind::pyramid) ||
+                     (first_order && want_sj && kind == LinearKind::hexahedron);
             };
             const auto lane_of = [&](const unsigned* done, std::vector<QualityBounds>& lane, std::size_t i) {
               return ((done[i / kNativeLanes] >> (i % kNativeLanes)) & 1u) != 0 ? &lane[i] : nullptr;
@@ -636,7 +672,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               fast_bounds.resize(ch.count);
               linear_validity_chunk(fast, soa.data(), ch.count, fast_bounds.data(), decided);
               const double share = static_cast<double>(stage_ticks() - ts) / static_cast<double>(ch.count);
-              const bool straight_lanes = straight_lanes_for(fast);
+              const bool straight_lanes = straight_lanes_for(fast, true);
               if (straight_lanes)  // outside the stage times
                 straight_lanes_of(type, kLinearRow, nullptr, nullptr, ch.count);
               nodes.resize(nn * 3);
@@ -710,7 +746,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
                   fast_bounds.resize(ch.count);
                   linear_validity_chunk(straight->kind(), soa.data(), ch.count, fast_bounds.data(), decided,
                                         margins.data(), kRow);
-                  straight_lanes = straight_lanes_for(straight->kind());
+                  straight_lanes = straight_lanes_for(straight->kind(), false);
                 } else {
                   std::fill(decided, decided + ch.count, false);  // a chunk of curved elements
                 }

@@ -31,6 +31,7 @@
 #include <optional>
 #include <span>
 
+#include "analysis/lane_vector.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
 #include "quadval/quality_bounds.hpp"
 
@@ -43,5 +44,12 @@ namespace quadval {
 /// @param space the pyramid's ScaledJacobianSpace (its frames and s)
 std::optional<QualityBounds> linear_pyramid_sj_bounds(const ScaledJacobianSpace& space, std::span<const double> x,
                                                       double tol);
+
+/// The same for kNativeLanes pyramids, one per lane (x[3 n + k]: node n's coordinate k),
+/// each with the bits linear_pyramid_sj_bounds gives it alone (the same lane code, its
+/// element in both lanes of two): bit l of the result set where out[l] holds lane l's
+/// bounds, the others as nothing above.
+unsigned linear_pyramid_sj_lanes(const ScaledJacobianSpace& space, const Lanes<kNativeLanes>* x, double tol,
+                                 QualityBounds* out);
 
 }  // namespace quadval

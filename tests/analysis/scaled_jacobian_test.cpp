@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "check_alone_test_util.hpp"
 #include "jacobian_test_util.hpp"
 #include "lanes_test_util.hpp"
 #include "scaled_jacobian_test_util.hpp"
@@ -523,6 +524,61 @@ TEST(ScaledJacobian, FirstOrderHexahedronRootBoundHoldsTheMinimum) {
   }
   EXPECT_GE(checked, 200);
   EXPECT_GE(settled, checked * 3 / 4);
+}
+
+// The check bounds the scaled Jacobian of valid first-order hexahedra four at a time
+// (trilinear_hex_sj_lanes): every element gets the bits scaled_jacobian_bounds gives it
+// alone, beside neighbours that the root bound settles, that it leaves to the general
+// path, or that are inverted.
+TEST(ScaledJacobian, FirstOrderHexahedronChunksMatchEachElementAloneBitForBit) {
+  std::mt19937 rng(52);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const ElementType& t = type_of(ElementFamily::hexahedron, 1);
+  std::vector<std::vector<double>> elements;
+  for (int e = 0; e < 1500; ++e) {
+    const double scale = std::pow(10.0, 2 * u(rng)), amplitude = e % 5 == 0 ? 0.45 : e % 3 == 0 ? 0.05 : 0.25;
+    const Vec shift = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
+    std::vector<double> x;
+    for (const RefPoint& p : reference_nodes(t))
+      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + amplitude * u(rng)) + shift[j]);
+    elements.push_back(x);
+  }
+  int settled = 0;
+  for (const auto& x : elements)
+    if (trilinear_hex_sj_bounds(x, 1e-2)) ++settled;
+  EXPECT_GT(settled, 900);
+  EXPECT_GT(test::expect_check_matches_alone(t, elements, CheckMeasure::scaled_jacobian,
+                                             [&](const std::vector<double>& x, const QualityOptions& q) {
+                                               return scaled_jacobian_bounds(t, x, q, false);
+                                             }),
+            900);
+}
+
+// Likewise first-order pyramids (linear_pyramid_sj_lanes), bilinear bases and
+// parallelograms, some inverted.
+TEST(ScaledJacobian, FirstOrderPyramidChunksMatchEachElementAloneBitForBit) {
+  std::mt19937 rng(53);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const ElementType& t = type_of(ElementFamily::pyramid, 1);
+  std::vector<std::vector<double>> elements;
+  for (int e = 0; e < 1500; ++e) {
+    const double scale = std::pow(10.0, 2 * u(rng)), amplitude = e % 5 == 0 ? 0.45 : e % 3 == 0 ? 0.0 : 0.15;
+    const Vec shift = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
+    std::vector<double> x;
+    for (const RefPoint& p : reference_nodes(t))
+      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + amplitude * u(rng)) + shift[j]);
+    elements.push_back(x);
+  }
+  const ScaledJacobianSpace& space = scaled_jacobian_space(t);
+  int settled = 0;
+  for (const auto& x : elements)
+    if (linear_pyramid_sj_bounds(space, x, 1e-2)) ++settled;
+  EXPECT_GT(settled, 300);
+  EXPECT_GT(test::expect_check_matches_alone(t, elements, CheckMeasure::scaled_jacobian,
+                                             [&](const std::vector<double>& x, const QualityOptions& q) {
+                                               return scaled_jacobian_bounds(t, x, q, false);
+                                             }),
+            700);
 }
 
 // The pointwise scaled Jacobian of a first-order pyramid by its definition (sj_at).
