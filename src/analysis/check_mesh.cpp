@@ -488,6 +488,19 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
             };
+            // Elements i0 .. i0 + kNativeLanes - 1 of a first-order chunk, one per lane: their
+            // first `values` vertex coordinates from `soa` (vertex v / 3, axis v % 3) into x; bit l
+            // of the result set where lane l's element is proven valid (spare lanes: a copy).
+            const auto vertex_lanes = [&](std::size_t i0, std::size_t count, std::size_t values,
+                                          Lanes<kNativeLanes>* x) {
+              unsigned valid = 0;
+              for (std::size_t l = 0; l < static_cast<std::size_t>(kNativeLanes); ++l) {
+                const std::size_t i = i0 + l < count ? i0 + l : i0;
+                for (std::size_t v = 0; v < values; ++v) x[v][l] = soa[v * kLinearRow + i];
+                if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid) valid |= 1u << l;
+              }
+              return valid;
+            };
             // mu of a first-order chunk's valid pyramids with a parallelogram base (W
             // constant; linear_pyramid_mu.hpp) and the scaled Jacobian's root bound of all of
             // its valid pyramids (linear_pyramid_sj.hpp), W = kNativeLanes at a time, into
@@ -500,12 +513,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               constexpr std::size_t kW = kNativeLanes;
               for (std::size_t i0 = 0; i0 < count; i0 += kW) {
                 Lanes<kW> x[15];
-                unsigned valid = 0;
-                for (std::size_t l = 0; l < kW; ++l) {
-                  const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
-                  for (std::size_t v = 0; v < 15; ++v) x[v][l] = soa[v * kLinearRow + i];
-                  if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid) valid |= 1u << l;
-                }
+                const unsigned valid = vertex_lanes(i0, count, 15, x);
                 lane_mu_done[i0 / kW] = valid == 0 || !mu_wanted
                                             ? 0u
                                             : valid & linear_pyramid_mu_lanes(t, x, qo.abs_tol, lane_mu.data() + i0);
@@ -524,12 +532,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               const bool wanted = scaled_jacobian_supported(t) && scaled_jacobian_straight_path_enabled();
               for (std::size_t i0 = 0; i0 < count; i0 += kW) {
                 Lanes<kW> x[24];
-                unsigned valid = 0;
-                for (std::size_t l = 0; l < kW; ++l) {
-                  const std::size_t i = i0 + l < count ? i0 + l : i0;  // spare lanes: a copy
-                  for (std::size_t v = 0; v < 24; ++v) x[v][l] = soa[v * kLinearRow + i];
-                  if (i0 + l < count && decided[i] && fast_bounds[i].validity == Validity::valid) valid |= 1u << l;
-                }
+                const unsigned valid = vertex_lanes(i0, count, 24, x);
                 lane_straight_sj_done[i0 / kW] =
                     valid == 0 || !wanted ? 0u
                                           : valid & trilinear_hex_sj_lanes(x, qo.abs_tol, lane_straight_sj.data() + i0);

@@ -129,8 +129,14 @@ StraightSimplexRatio<W> constant_columns_ratio(const Lanes<W> (*col)[8][3], int 
     margins[c] = lanes3::up<W>((beta + rounding[c]) * lanes3::kSlack);
     for (int k = 0; k < 3; ++k) edges[3 * c + k] = col[c][0][k];
   }
+  const unsigned constant = lanes3::mask_bits<W>(spread <= 1e-9 * scale);
+  if (constant == 0) {  // most prisms and pyramids: their columns vary
+    StraightSimplexRatio<W> none;
+    none.lower = none.upper = L{};
+    return none;
+  }
   StraightSimplexRatio<W> r = straight_tet_ratio<W>(edges, margins, jinv);
-  r.ok &= lanes3::mask_bits<W>(spread <= 1e-9 * scale);
+  r.ok &= constant;
   return r;
 }
 

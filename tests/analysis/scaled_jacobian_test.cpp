@@ -526,23 +526,33 @@ TEST(ScaledJacobian, FirstOrderHexahedronRootBoundHoldsTheMinimum) {
   EXPECT_GE(settled, checked * 3 / 4);
 }
 
-// The check bounds the scaled Jacobian of valid first-order hexahedra four at a time
-// (trilinear_hex_sj_lanes): every element gets the bits scaled_jacobian_bounds gives it
-// alone, beside neighbours that the root bound settles, that it leaves to the general
-// path, or that are inverted.
-TEST(ScaledJacobian, FirstOrderHexahedronChunksMatchEachElementAloneBitForBit) {
-  std::mt19937 rng(52);
+// `count` first-order elements of t: the reference nodes each moved at random by up to
+// amplitude(e) per axis, then scaled by 10^[-2, 2] and shifted by up to 10.
+template <class Amplitude>
+std::vector<std::vector<double>> perturbed_reference_elements(const ElementType& t, int count, Amplitude amplitude,
+                                                              std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1, 1);
-  const ElementType& t = type_of(ElementFamily::hexahedron, 1);
   std::vector<std::vector<double>> elements;
-  for (int e = 0; e < 1500; ++e) {
-    const double scale = std::pow(10.0, 2 * u(rng)), amplitude = e % 5 == 0 ? 0.45 : e % 3 == 0 ? 0.05 : 0.25;
+  for (int e = 0; e < count; ++e) {
+    const double scale = std::pow(10.0, 2 * u(rng)), a = amplitude(e);
     const Vec shift = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
     std::vector<double> x;
     for (const RefPoint& p : reference_nodes(t))
-      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + amplitude * u(rng)) + shift[j]);
+      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + a * u(rng)) + shift[j]);
     elements.push_back(x);
   }
+  return elements;
+}
+
+// The check bounds the scaled Jacobian of valid first-order hexahedra four at a time
+// (trilinear_hex_sj_lanes): every element gets the bits scaled_jacobian_bounds gives it
+// alone, beside neighbours that the root bound settles and ones it leaves to the general
+// path (strongly perturbed, some of them inverted).
+TEST(ScaledJacobian, FirstOrderHexahedronChunksMatchEachElementAloneBitForBit) {
+  std::mt19937 rng(52);
+  const ElementType& t = type_of(ElementFamily::hexahedron, 1);
+  const auto elements =
+      perturbed_reference_elements(t, 1500, [](int e) { return e % 5 == 0 ? 0.45 : e % 3 == 0 ? 0.05 : 0.25; }, rng);
   int settled = 0;
   for (const auto& x : elements)
     if (trilinear_hex_sj_bounds(x, 1e-2)) ++settled;
@@ -558,17 +568,9 @@ TEST(ScaledJacobian, FirstOrderHexahedronChunksMatchEachElementAloneBitForBit) {
 // parallelograms, some inverted.
 TEST(ScaledJacobian, FirstOrderPyramidChunksMatchEachElementAloneBitForBit) {
   std::mt19937 rng(53);
-  std::uniform_real_distribution<double> u(-1, 1);
   const ElementType& t = type_of(ElementFamily::pyramid, 1);
-  std::vector<std::vector<double>> elements;
-  for (int e = 0; e < 1500; ++e) {
-    const double scale = std::pow(10.0, 2 * u(rng)), amplitude = e % 5 == 0 ? 0.45 : e % 3 == 0 ? 0.0 : 0.15;
-    const Vec shift = {10 * u(rng), 10 * u(rng), 10 * u(rng)};
-    std::vector<double> x;
-    for (const RefPoint& p : reference_nodes(t))
-      for (std::size_t j = 0; j < 3; ++j) x.push_back(scale * (p[j] + amplitude * u(rng)) + shift[j]);
-    elements.push_back(x);
-  }
+  const auto elements =
+      perturbed_reference_elements(t, 1500, [](int e) { return e % 5 == 0 ? 0.45 : e % 3 == 0 ? 0.0 : 0.15; }, rng);
   const ScaledJacobianSpace& space = scaled_jacobian_space(t);
   int settled = 0;
   for (const auto& x : elements)
