@@ -6,7 +6,11 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "analysis/outward_rounding.hpp"
@@ -22,43 +26,73 @@ constexpr int kFinestStep = 12;  // coordinates stay multiples of 2^-12: 1 - sum
 constexpr int kMaxEvaluations = 400;
 double up(double x) { return next_up(x); }
 
-// One tensor space (J's or a column's): per factor its simplex and multinomials.
+// One simplex factor's basis in a form cheap to evaluate: per coefficient its exponents
+// (alpha_0 .. alpha_d) and multinomial n! / prod alpha!. Shared per (dim, degree), as
+// bernstein_simplex is: a probe is built per element, its tables only once.
+struct FactorTable {
+  int dim = 0, degree = 0, size = 0;
+  std::vector<std::uint8_t> exponents;  // size x (dim + 1)
+  std::vector<double> multinomial;
+};
+
+FactorTable build_factor_table(int dim, int degree) {
+  const BernsteinSimplex& b = bernstein_simplex(dim, degree);
+  QV_ASSERT(degree < 32, "degree " << degree);
+  FactorTable t{dim, degree, b.size(), {}, {}};
+  for (const auto& alpha : b.multi_indices()) {
+    // n! / prod alpha_a!, built as a product of binomials: exact integers far below 2^53.
+    std::uint64_t v = 1;
+    int taken = 0;
+    for (int a = 0; a <= dim; ++a) {
+      t.exponents.push_back(static_cast<std::uint8_t>(alpha[static_cast<std::size_t>(a)]));
+      for (int k = 1; k <= alpha[static_cast<std::size_t>(a)]; ++k) v = v * static_cast<std::uint64_t>(++taken) / static_cast<std::uint64_t>(k);
+    }
+    t.multinomial.push_back(static_cast<double>(v));
+  }
+  return t;
+}
+
+const FactorTable& factor_table(int dim, int degree) {
+  static std::mutex mutex;
+  static std::map<std::pair<int, int>, std::unique_ptr<const FactorTable>> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[{dim, degree}];
+  if (!slot) slot = std::make_unique<const FactorTable>(build_factor_table(dim, degree));
+  return *slot;
+}
+
+// One tensor space (J's or a column's): its factors, first varying fastest.
 struct Space {
-  std::vector<const BernsteinSimplex*> factors;
-  std::vector<std::vector<double>> multinomial;  // per factor, per coefficient: n! / prod alpha!
+  std::array<const FactorTable*, 3> factors{};
+  int num_factors = 0;
   int size = 1;
+  int largest_factor = 0;
   int roundings = 0;  // of one basis value: sum over factors of n + d + 1, plus the tensor's
 };
 
 Space make_space(const std::vector<FactorDegree>& degrees) {
   Space s;
+  QV_ASSERT(degrees.size() <= 3, degrees.size() << " factors");
   for (const FactorDegree& fd : degrees) {
-    const BernsteinSimplex& b = bernstein_simplex(fd.dim, fd.degree);
-    s.factors.push_back(&b);
-    std::vector<double> m;
-    for (const auto& alpha : b.multi_indices()) {
-      // n! / prod alpha_a!, built as a product of binomials: exact integers far below 2^53.
-      std::uint64_t v = 1;
-      int taken = 0;
-      for (int a = 0; a <= fd.dim; ++a)
-        for (int k = 1; k <= alpha[static_cast<std::size_t>(a)]; ++k) v = v * static_cast<std::uint64_t>(++taken) / static_cast<std::uint64_t>(k);
-      m.push_back(static_cast<double>(v));
-    }
-    s.multinomial.push_back(std::move(m));
-    s.size *= b.size();
+    const FactorTable& t = factor_table(fd.dim, fd.degree);
+    s.factors[static_cast<std::size_t>(s.num_factors++)] = &t;
+    s.size *= t.size;
+    s.largest_factor = std::max(s.largest_factor, t.size);
     s.roundings += fd.degree + fd.dim + 1;
   }
-  s.roundings += static_cast<int>(degrees.size()) - 1;
+  s.roundings += s.num_factors - 1;
   return s;
 }
 
-// The tensor basis values at point x (the factors' local coordinates, concatenated).
-void basis_at(const Space& s, const double* x, std::vector<double>& out, std::vector<double>& factor_values) {
-  out.assign(1, 1.0);
+// The tensor basis values at point x (the factors' local coordinates, concatenated) into
+// out[0 .. s.size); factor_values holds at least s.largest_factor values.
+void basis_at(const Space& s, const double* x, double* out, double* factor_values) {
+  out[0] = 1.0;
+  std::size_t inner = 1;
   int at = 0;
-  for (std::size_t f = 0; f < s.factors.size(); ++f) {
-    const BernsteinSimplex& b = *s.factors[f];
-    const int d = b.dim(), n = b.degree();
+  for (int f = 0; f < s.num_factors; ++f) {
+    const FactorTable& t = *s.factors[static_cast<std::size_t>(f)];
+    const int d = t.dim, n = t.degree;
     std::array<double, 4> lambda{1, 0, 0, 0};
     for (int c = 0; c < d; ++c) {
       lambda[static_cast<std::size_t>(c + 1)] = x[at + c];
@@ -66,30 +100,25 @@ void basis_at(const Space& s, const double* x, std::vector<double>& out, std::ve
     }
     at += d;
     std::array<std::array<double, 32>, 4> power;  // rows 0..d, entries 0..n set below
-    QV_ASSERT(n < 32, "degree " << n);
     for (int a = 0; a <= d; ++a) {
-      power[static_cast<std::size_t>(a)][0] = 1;
-      for (int k = 1; k <= n; ++k)
-        power[static_cast<std::size_t>(a)][static_cast<std::size_t>(k)] =
-            power[static_cast<std::size_t>(a)][static_cast<std::size_t>(k - 1)] * lambda[static_cast<std::size_t>(a)];
+      double* p = power[static_cast<std::size_t>(a)].data();
+      p[0] = 1;
+      for (int k = 1; k <= n; ++k) p[k] = p[k - 1] * lambda[static_cast<std::size_t>(a)];
     }
-    factor_values.resize(static_cast<std::size_t>(b.size()));
-    const auto alphas = b.multi_indices();
-    for (std::size_t i = 0; i < alphas.size(); ++i) {
-      double v = s.multinomial[f][i];
-      for (int a = 0; a <= d; ++a)
-        v *= power[static_cast<std::size_t>(a)][static_cast<std::size_t>(alphas[i][static_cast<std::size_t>(a)])];
+    const std::uint8_t* e = t.exponents.data();
+    for (int i = 0; i < t.size; ++i, e += d + 1) {
+      double v = t.multinomial[static_cast<std::size_t>(i)];
+      for (int a = 0; a <= d; ++a) v *= power[static_cast<std::size_t>(a)][e[a]];
       factor_values[i] = v;
     }
     // Factor f varies slowest so far: out (earlier factors) fastest, as the coefficients.
-    const std::size_t inner = out.size();
-    out.resize(inner * factor_values.size());
-    for (std::size_t i = factor_values.size(); i-- > 0;)
+    for (std::size_t i = static_cast<std::size_t>(t.size); i-- > 0;)
       for (std::size_t k = 0; k < inner; ++k) out[i * inner + k] = out[k] * factor_values[i];
+    inner *= static_cast<std::size_t>(t.size);
   }
 }
 
-double dot(std::span<const double> c, const std::vector<double>& basis) {
+double dot(std::span<const double> c, const double* basis) {
   double sum = 0;
   for (std::size_t i = 0; i < c.size(); ++i) sum += c[i] * basis[i];
   return sum;
@@ -102,6 +131,13 @@ class Probe {
     j_space_ = make_space(*in.j_degrees);
     for (std::size_t c = 0; c < dim_; ++c) col_space_[c] = make_space(*in.col_degrees[c]);
     for (const FactorDegree& fd : *in.j_degrees) factor_dims_.push_back(fd.dim);
+    int size = j_space_.size, factor = j_space_.largest_factor;
+    for (std::size_t c = 0; c < dim_; ++c) {
+      size = std::max(size, col_space_[c].size);
+      factor = std::max(factor, col_space_[c].largest_factor);
+    }
+    basis_.resize(static_cast<std::size_t>(size));
+    factor_values_.resize(static_cast<std::size_t>(factor));
   }
 
   // sj / s at x in floating point (the search's objective); +inf where no frame has
@@ -183,11 +219,11 @@ class Probe {
     return sqrt_rn(sum);
   }
   void evaluate(const double* x) {
-    basis_at(j_space_, x, basis_, factor_values_);
-    j_ = dot(in_.j, basis_);
+    basis_at(j_space_, x, basis_.data(), factor_values_.data());
+    j_ = dot(in_.j, basis_.data());
     for (std::size_t c = 0; c < dim_; ++c) {
-      basis_at(col_space_[c], x, basis_, factor_values_);
-      for (std::size_t k = 0; k < 3; ++k) col_[c][k] = dot(in_.col[c][k], basis_);
+      basis_at(col_space_[c], x, basis_.data(), factor_values_.data());
+      for (std::size_t k = 0; k < 3; ++k) col_[c][k] = dot(in_.col[c][k], basis_.data());
     }
   }
 

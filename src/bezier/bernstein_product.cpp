@@ -56,12 +56,14 @@ mpz_class multinomial(const MultiIndex& a, int dim) {
   return factorial(n) / den;
 }
 
-// Exact weights without GMP where they fit. A weight is a ratio of products of
-// multinomials, kept in 128-bit integers in lowest terms; when both parts are below 2^53
-// they are exact doubles, and their IEEE quotient is the double nearest to the exact ratio
-// (never a tie: the reduced ratio is either a double or not dyadic), as nearest_double
-// rounds it. Anything larger goes through GMP. (GMP here was about 0.25 ms of a 2.2 ms
-// first scaled-Jacobian check of quad_h0.4_o2.)
+// Exact weights without GMP where they fit. A weight is a ratio of integers kept in
+// 128 bits; when both parts are below 2^53 they are exact doubles, and their IEEE quotient
+// is the double nearest to the exact ratio (never a tie: the ratio is either a double or
+// not dyadic), as nearest_double rounds it, reduced or not. Anything larger is reduced to
+// lowest terms and, if still too large, goes through GMP. (GMP here was about 0.25 ms of a
+// 2.2 ms first scaled-Jacobian check of quad_h0.4_o2; reducing every weight by gcd, and
+// multinomials in 128 bits per pair, were half of the set-up of a product after that:
+// (tetrahedron 6 x 6) 0.86 -> 0.36 ms, (triangle 6 x 6) 71 -> 28 us, warm.)
 __extension__ typedef unsigned __int128 U128;  // GCC and Clang
 
 // n! / prod alpha_a!, or 0 when it does not fit 128 bits. Each step m * n / t is exact: m
@@ -78,6 +80,29 @@ U128 multinomial128(const MultiIndex& a, int dim) {
   return m;
 }
 
+// C(n, k) for 0 <= k <= n <= rows, each 0 where it does not fit 128 bits.
+class PascalTriangle {
+ public:
+  explicit PascalTriangle(int rows) : c_(static_cast<std::size_t>((rows + 1) * (rows + 2) / 2)) {
+    for (int n = 0; n <= rows; ++n) {
+      at(n, 0) = at(n, n) = 1;
+      for (int k = 1; k < n; ++k) {
+        const U128 a = at(n - 1, k - 1), b = at(n - 1, k);
+        U128 sum;
+        at(n, k) = a == 0 || b == 0 || __builtin_add_overflow(a, b, &sum) ? 0 : sum;
+      }
+    }
+  }
+  U128 operator()(int n, int k) const { return c_[index(n, k)]; }
+
+ private:
+  static std::size_t index(int n, int k) { return static_cast<std::size_t>(n * (n + 1) / 2 + k); }
+  U128& at(int n, int k) { return c_[index(n, k)]; }
+  std::vector<U128> c_;
+};
+
+constexpr U128 kExactDoubles = U128(1) << 53;
+
 U128 gcd128(U128 a, U128 b) {
   if ((a >> 64) == 0 && (b >> 64) == 0)  // the usual case: no 128-bit division
     return std::gcd(static_cast<std::uint64_t>(a), static_cast<std::uint64_t>(b));
@@ -89,7 +114,7 @@ U128 gcd128(U128 a, U128 b) {
   return a;
 }
 
-// num / den > 0 in lowest terms; den == 0 marks one that did not fit.
+// num / den > 0 (in lowest terms where said); den == 0 marks one that did not fit.
 struct Fraction {
   U128 num = 1, den = 1;
 };
@@ -109,10 +134,20 @@ Fraction times(const Fraction& a, const Fraction& b) {
   return r;
 }
 
+// a b without reducing (den 0: it does not fit, or one of them did not).
+Fraction unreduced_times(const Fraction& a, const Fraction& b) {
+  Fraction r;
+  if (a.den == 0 || b.den == 0 || __builtin_mul_overflow(a.num, b.num, &r.num) ||
+      __builtin_mul_overflow(a.den, b.den, &r.den))
+    return {0, 0};
+  return r;
+}
+
+Fraction lowest_terms(const Fraction& w) { return w.den == 0 ? w : ratio(w.num, w.den); }
+
 // The double nearest to w, or `exact()` (an mpq_class) rounded by GMP when w did not fit.
 template <class Exact>
 double nearest(const Fraction& w, Exact exact) {
-  constexpr U128 kExactDoubles = U128(1) << 53;
   if (w.den != 0 && w.num <= kExactDoubles && w.den <= kExactDoubles)
     return static_cast<double>(w.num) / static_cast<double>(w.den);
   return nearest_double(exact());
@@ -191,26 +226,31 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
     const auto& gi = g_index[fac];
     const auto& hi = h_index_of[fac];
     const MultiIndexTable h_index(hi, nu + mu);
-    // The multinomials of every multi-index, once (not per pair).
-    const auto multinomials = [d](const std::vector<MultiIndex>& list) {
-      std::vector<U128> out;
-      out.reserve(list.size());
-      for (const MultiIndex& a : list) out.push_back(multinomial128(a, d));
-      return out;
-    };
-    const std::vector<U128> f_alpha = multinomials(fi), g_alpha = multinomials(gi), h_alpha = multinomials(hi);
+    // Weight of (i, j): prod_a C(k_a, i_a) / C(nu + mu, nu) with k = i + j (B_i B_j =
+    // that times B_k), an integer over the factor's one denominator: both are exact doubles
+    // far beyond the degrees used, so their IEEE quotient is the nearest double to the
+    // weight (never a tie: a ratio of integers below 2^53 is either a double or not
+    // dyadic). Lowest terms and GMP only where a part is too large.
+    const PascalTriangle binomial(nu + mu);
+    const U128 den = binomial(nu + mu, nu);
+    const bool small = den != 0 && den <= kExactDoubles;
     std::vector<int> terms(hi.size(), 0);
+    entries_[fac].reserve(fi.size() * gi.size());
+    exact_w[fac].reserve(fi.size() * gi.size());
     for (std::size_t i = 0; i < fi.size(); ++i)
       for (std::size_t j = 0; j < gi.size(); ++j) {
         MultiIndex k{};
-        for (std::size_t a = 0; a < 4; ++a) k[a] = fi[i][a] + gi[j][a];
-        const int kk = h_index(k);
-        QV_ASSERT(kk >= 0 && hi[static_cast<std::size_t>(kk)] == k, "multi-index outside the product space");
-        U128 num;
-        const bool fits = !__builtin_mul_overflow(f_alpha[i], g_alpha[j], &num);
-        const Fraction w = ratio(fits ? num : 0, h_alpha[static_cast<std::size_t>(kk)]);
+        U128 num = 1;
+        for (std::size_t a = 0; a < 4; ++a) {
+          k[a] = fi[i][a] + gi[j][a];
+          if (num != 0 && __builtin_mul_overflow(num, binomial(k[a], fi[i][a]), &num)) num = 0;
+        }
+        const int kk = h_index(k);  // k has degree nu + mu: components 1-3 place it
+        QV_ASSERT(kk >= 0, "multi-index outside the product space");
         Entry e{static_cast<int>(i), static_cast<int>(j), kk, 0.0};
-        e.w = nearest(w, [&] { return gmp_weight(fac, e); });
+        const Fraction w = small && num != 0 ? Fraction{num, den} : ratio(num, den);
+        e.w = small && num != 0 ? static_cast<double>(w.num) / static_cast<double>(w.den)
+                                : nearest(w, [&] { return gmp_weight(fac, e); });
         entries_[fac].push_back(e);
         exact_w[fac].push_back(w);
         ++terms[static_cast<std::size_t>(kk)];
@@ -236,8 +276,8 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
     // weights of unused factors not multiplied at all (GMP products are most of the set-up).
     for (std::size_t a2 = 0; a2 < entries_[2].size(); ++a2)
       for (std::size_t a1 = 0; a1 < entries_[1].size(); ++a1) {
-        const Fraction w12 = times(exact_w[1][a1], exact_w[2][a2]);
-        const bool unit = w12.num == 1 && w12.den == 1;
+        const Fraction w12 = unreduced_times(exact_w[1][a1], exact_w[2][a2]);
+        const bool unit = w12.den != 0 && w12.num == w12.den;
         for (std::size_t a0 = 0; a0 < entries_[0].size(); ++a0) {
           const Entry& e0 = entries_[0][a0];
           const Entry& e1 = entries_[1][a1];
@@ -245,7 +285,11 @@ BernsteinProduct::BernsteinProduct(std::vector<FactorDegree> f, std::vector<Fact
           const int i = e0.i * f_stride_[0] + e1.i * f_stride_[1] + e2.i * f_stride_[2];
           const int j = e0.j * g_stride_[0] + e1.j * g_stride_[1] + e2.j * g_stride_[2];
           const int k = e0.k * h_stride_[0] + e1.k * h_stride_[1] + e2.k * h_stride_[2];
-          const double w = unit ? e0.w : nearest(times(exact_w[0][a0], w12), [&] {
+          const Fraction w012 = unit ? Fraction{} : unreduced_times(exact_w[0][a0], w12);
+          const double w = unit ? e0.w
+                           : w012.den != 0 && w012.den <= kExactDoubles
+                               ? static_cast<double>(w012.num) / static_cast<double>(w012.den)
+                               : nearest(times(lowest_terms(exact_w[0][a0]), lowest_terms(w12)), [&] {
             mpq_class exact = gmp_weight(0, e0);
             for (std::size_t fac = 1; fac < f_degrees_.size(); ++fac) exact *= gmp_weight(fac, fac == 1 ? e1 : e2);
             return exact;
