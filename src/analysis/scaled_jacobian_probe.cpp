@@ -124,6 +124,68 @@ double dot(std::span<const double> c, const double* basis) {
   return sum;
 }
 
+// The points of the degree-4 lattice of every factor, as a tensor product.
+std::vector<std::array<double, 3>> start_points(const std::vector<int>& dims) {
+  std::vector<std::array<double, 3>> points{{0, 0, 0}};
+  std::size_t at = 0;
+  for (int d : dims) {
+    std::vector<std::array<double, 3>> next;
+    const BernsteinSimplex& lattice = bernstein_simplex(d, 4);
+    for (const auto& p : points)
+      for (const auto& alpha : lattice.multi_indices()) {
+        std::array<double, 3> q = p;
+        for (int c = 0; c < d; ++c) q[at + static_cast<std::size_t>(c)] = alpha[static_cast<std::size_t>(c + 1)] / 4.0;
+        next.push_back(q);
+      }
+    points = std::move(next);
+    at += static_cast<std::size_t>(d);
+  }
+  return points;
+}
+
+
+// The basis values of J's space and of the columns' at the start points, which are the same
+// for every element of one space: the start (most of a triangle's evaluations) is then
+// dot products only, with the same values basis_at gives there.
+struct Lattice {
+  std::vector<std::array<double, 3>> points;
+  std::vector<double> j;                   // point p's values at p * j_size
+  std::array<std::vector<double>, 3> col;  // likewise per column
+};
+
+const Lattice& lattice_of(const Space& j_space, const std::array<Space, 3>& col_space, std::size_t columns,
+                          const std::vector<int>& factor_dims) {
+  static std::mutex mutex;
+  static std::map<std::vector<int>, std::unique_ptr<const Lattice>> cache;
+  std::vector<int> key;
+  for (std::size_t c = 0; c <= columns; ++c) {
+    const Space& sp = c == 0 ? j_space : col_space[c - 1];
+    for (int f = 0; f < sp.num_factors; ++f)
+      key.insert(key.end(), {sp.factors[static_cast<std::size_t>(f)]->dim, sp.factors[static_cast<std::size_t>(f)]->degree});
+    key.push_back(-1);
+  }
+  const std::lock_guard<std::mutex> lock(mutex);
+  auto& slot = cache[key];
+  if (!slot) {
+    auto l = std::make_unique<Lattice>();
+    l->points = start_points(factor_dims);
+    int largest = 0;
+    for (std::size_t c = 0; c <= columns; ++c)
+      for (int f = 0; f < (c == 0 ? j_space : col_space[c - 1]).num_factors; ++f)
+        largest = std::max(largest, (c == 0 ? j_space : col_space[c - 1]).factors[static_cast<std::size_t>(f)]->size);
+    std::vector<double> factor_values(static_cast<std::size_t>(largest));
+    const auto fill = [&](const Space& sp, std::vector<double>& out) {
+      out.resize(l->points.size() * static_cast<std::size_t>(sp.size));
+      for (std::size_t p = 0; p < l->points.size(); ++p)
+        basis_at(sp, l->points[p].data(), out.data() + p * static_cast<std::size_t>(sp.size), factor_values.data());
+    };
+    fill(j_space, l->j);
+    for (std::size_t c = 0; c < columns; ++c) fill(col_space[c], l->col[c]);
+    slot = std::move(l);
+  }
+  return *slot;
+}
+
 class Probe {
  public:
   Probe(const ScaledJacobianSpace& space, const QuotientInput& in) : space_(space), in_(in) {
@@ -138,19 +200,25 @@ class Probe {
     }
     basis_.resize(static_cast<std::size_t>(size));
     factor_values_.resize(static_cast<std::size_t>(factor));
+    lattice_ = &lattice_of(j_space_, col_space_, dim_, factor_dims_);
+  }
+
+  // The start points, and the estimate at start point p (as estimate at that point).
+  const std::vector<std::array<double, 3>>& start() const { return lattice_->points; }
+  double estimate_start(std::size_t p) {
+    j_ = dot(in_.j, lattice_->j.data() + p * static_cast<std::size_t>(j_space_.size));
+    for (std::size_t c = 0; c < dim_; ++c) {
+      const double* basis = lattice_->col[c].data() + p * static_cast<std::size_t>(col_space_[c].size);
+      for (std::size_t k = 0; k < 3; ++k) col_[c][k] = dot(in_.col[c][k], basis);
+    }
+    return objective();
   }
 
   // sj / s at x in floating point (the search's objective); +inf where no frame has
   // nonzero column norms.
   double estimate(const double* x) {
     evaluate(x);
-    double best = kInf;
-    for (const Frame& fr : space_.frames()) {
-      double norms = 1;
-      for (std::size_t j = 0; j < dim_; ++j) norms *= frame_norm(fr, j);
-      if (norms > 0) best = std::min(best, j_ / norms);
-    }
-    return best;
+    return objective();
   }
 
   // A certified upper bound of sj(E) at x, or 0 where J < 0 is not certain there.
@@ -207,6 +275,16 @@ class Probe {
     return m;
   }
   int col_size(std::size_t c) const { return static_cast<int>(in_.col[c][0].size()); }
+  // The estimate from the values at the last point evaluated.
+  double objective() const {
+    double best = kInf;
+    for (const Frame& fr : space_.frames()) {
+      double norms = 1;
+      for (std::size_t j = 0; j < dim_; ++j) norms *= frame_norm(fr, j);
+      if (norms > 0) best = std::min(best, j_ / norms);
+    }
+    return best;
+  }
   // |frame column j| from the columns' values at the last evaluated point.
   double frame_norm(const Frame& fr, std::size_t j) const {
     double sum = 0;
@@ -234,28 +312,10 @@ class Probe {
   std::array<Space, 3> col_space_;
   std::vector<int> factor_dims_;
   std::vector<double> basis_, factor_values_;
+  const Lattice* lattice_ = nullptr;
   double j_ = 0;
   std::array<std::array<double, 3>, 3> col_{};
 };
-
-// The points of the degree-4 lattice of every factor, as a tensor product.
-std::vector<std::array<double, 3>> start_points(const std::vector<int>& dims) {
-  std::vector<std::array<double, 3>> points{{0, 0, 0}};
-  std::size_t at = 0;
-  for (int d : dims) {
-    std::vector<std::array<double, 3>> next;
-    const BernsteinSimplex& lattice = bernstein_simplex(d, 4);
-    for (const auto& p : points)
-      for (const auto& alpha : lattice.multi_indices()) {
-        std::array<double, 3> q = p;
-        for (int c = 0; c < d; ++c) q[at + static_cast<std::size_t>(c)] = alpha[static_cast<std::size_t>(c + 1)] / 4.0;
-        next.push_back(q);
-      }
-    points = std::move(next);
-    at += static_cast<std::size_t>(d);
-  }
-  return points;
-}
 
 }  // namespace
 
@@ -265,12 +325,12 @@ SjProbe probe_scaled_jacobian(const ScaledJacobianSpace& space, const QuotientIn
   int evaluations = 0;
   std::array<double, 3> best{};
   double best_value = kInf;
-  for (const auto& p : start_points(probe.factor_dims())) {
-    const double v = probe.estimate(p.data());
+  for (std::size_t p = 0; p < probe.start().size(); ++p) {
+    const double v = probe.estimate_start(p);
     ++evaluations;
     if (v < best_value) {
       best_value = v;
-      best = p;
+      best = probe.start()[p];
     }
   }
   if (!(best_value < 0)) return {0, best};
