@@ -52,6 +52,10 @@ struct CheckOptions {
   /// subdivision limit (max_subdivisions).
   double quality_abs_tol = 1e-2;
   int threads = 0;  ///< at most this many (0: OpenMP's default); fewer when the work is small
+  /// Where the estimated work is moderate, start the other threads only once the calling
+  /// thread's pace shows them worth their cost (check_mesh.cpp); false: at once, up to the
+  /// estimate's count (tests of that count). The answers are the same either way.
+  bool threads_on_demand = true;
   /// Worst elements the summary keeps (CheckSummary::worst; at least 10, the JSON's list).
   std::size_t worst = 10;
   /// Called now and then from the calling thread with (elements done, total).

@@ -325,16 +325,15 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
     auto straight = std::make_unique<const StraightSidedMargin>(type, jacobian_space(type), report.planar);
     if (straight->kind() != LinearKind::none) straight_of[b] = std::move(straight);
   }
-  // Threads only for work worth them: each extra one costs its start (about 0.1 ms,
-  // worker_threads.hpp) and the closing join, and more when the cores are busy
-  // (results do not depend on it), so one thread per kWorkPerThread units (about 1 ms),
-  // and never more than chunks.
+  // Threads at most: each extra one costs its start (about 0.1 ms, worker_threads.hpp) and
+  // the closing join, and more when the cores are busy (results do not depend on it), so
+  // one thread per kWorkPerThread units (about 1 ms), and never more than chunks; they
+  // start only once the work shows it is worth them (below).
   constexpr double kWorkPerThread = 1e6;
   const int requested = options.threads > 0 ? options.threads : omp_get_max_threads();
   const auto useful = static_cast<std::size_t>(std::max(1.0, std::ceil(work / kWorkPerThread)));
   const int threads = static_cast<int>(
       std::max<std::size_t>(1, std::min({static_cast<std::size_t>(requested), chunks.size(), useful})));
-  report.threads = threads;
   std::vector<ThreadStats> stats(static_cast<std::size_t>(threads));
   for (ThreadStats& st : stats) st.summary = empty_summary(file, options.measure, options.worst);
   std::atomic<std::size_t> done{0};
@@ -381,9 +380,49 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   // of system time in a 0.20 s run). A step delays a flush by at most 20 microseconds.
   const auto pause = [] { std::this_thread::sleep_for(std::chrono::microseconds(20)); };
 
+  // The other threads start at once where the estimate is large, else only once the
+  // calling thread's progress shows the work worth them (run_on_threads_on_demand): when
+  // the rest, at its pace so far, would take it alone more than kMoreThreadsAbove, judged
+  // from kJudgeAfter of work on, the pace measured from half that on (the first elements
+  // pay for set-ups and cold code). The estimate cannot tell a mesh of straight elements
+  // from one of inverted curved ones: mu of the shared curved meshes, estimate and one
+  // thread's time: tri_h0.4_o4 2.1e7 and 0.8 ms, hex_box_N20 2.6e7 and 35 ms,
+  // warped_prism_o2 3.5e7 and 6.4 ms. On the small ones two threads from the start took
+  // longer than one (CLI, medians of 21 alternating runs): quad_h0.4_o2 sj 1.02 vs 0.84 ms,
+  // mu 0.64 vs 0.53; tri_h0.4_o4 sj 1.03 vs 0.90, mu 0.77 vs 0.47; warped_pyramid_o1 sj
+  // 0.72 vs 0.62 ms. On demand everywhere cost the medium ones 0.2-0.4 ms (tets_h0.8_o2 mu
+  // 4.4 -> 4.8 ms), hence the immediate start above kStartAtOnce.
+  constexpr double kStartAtOnce = 3e7, kMoreThreadsAbove = 2e-3, kJudgeAfter = 0.4e-3;
   const double setup_seconds = now_seconds() - t0;
-  run_on_threads(threads, [&](int thread) {
+  const int threads_used = run_on_threads_on_demand(threads, [&](int thread, const std::function<void()>& more) {
     const bool master = thread == 0;
+    // The calling thread's count of finished elements while it is alone, and the point
+    // from which its pace is measured.
+    std::size_t alone_done = 0, paced_from = 0;
+    bool asked = !master || threads == 1;
+    if (!asked && (work >= kStartAtOnce || !options.threads_on_demand)) {
+      more();
+      asked = true;
+    }
+    double pace_from = 0;
+    const double alone_from = now_seconds();
+    const auto maybe_more = [&] {
+      if (asked) return;
+      const double now = now_seconds();
+      if (pace_from == 0) {
+        if (now - alone_from >= 0.5 * kJudgeAfter) {
+          pace_from = now;
+          paced_from = alone_done;
+        }
+        return;
+      }
+      if (now - alone_from < kJudgeAfter || alone_done <= paced_from) return;
+      const double left = static_cast<double>(total - std::min(total, alone_done));
+      if ((now - pace_from) / static_cast<double>(alone_done - paced_from) * left > kMoreThreadsAbove) {
+        more();
+        asked = true;
+      }
+    };
     BoundsWorkspace workspace;
     auto& ws = workspace.impl();
     ThreadStats& st = stats[static_cast<std::size_t>(thread)];
@@ -451,6 +490,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               out = bounds_of(type, std::span<const double>(xe, nn * 3), qo, report.planar, known);
               ++qc.computed;
               if (!out.tolerance_met) ++qc.tolerance_not_met;
+              maybe_more();
             };
             // mu and the scaled Jacobian of an element whose validity is known (mu given
             // when the chunk's lanes computed it).
@@ -487,6 +527,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               qualities(index, xe, b.validity, known, mu_given, sj_given);
               if (b.exact) ++st.exact;
               st.add(b.stage, b.validity, ticks);
+              ++alone_done;
             };
             // Elements i0 .. i0 + kNativeLanes - 1 of a first-order chunk, one per lane: their
             // first `values` vertex coordinates from `soa` (vertex v / 3, axis v % 3) into x; bit l
@@ -636,6 +677,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
               ec.bounds = b;
               ec.analysed = true;
               st.add(b.stage, b.validity, ticks);
+              ++alone_done;
               if (!want_mu && !want_sj) return;
               const std::size_t i = index - ch.out;
               const QualityBounds* mu_given = in_lanes && want_mu ? lane_of(lane_mu_done, lane_mu, i) : nullptr;
@@ -898,6 +940,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
         }
       }
       st.busy += now_seconds() - busy_from;
+      maybe_more();
       remaining[batch].fetch_sub(1, std::memory_order_acq_rel);  // publishes the results
       if (master && batched) flush_ready();
     }
@@ -907,6 +950,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
         if (flushed.load(std::memory_order_relaxed) < num_batches) pause();
       }
   });
+  report.threads = threads_used;
   if (failure) std::rethrow_exception(failure);
 
   const double seconds_per_tick = tick_rate.seconds_per_tick();
@@ -936,7 +980,7 @@ CheckSummary check_mesh_streamed(const Mesh& mesh, const CheckOptions& options, 
   // threads' work shared over them, which is what the analysis takes without a sink.
   double busy = 0;
   for (const ThreadStats& st : stats) busy += st.busy;
-  report.seconds = std::max(now_seconds() - t0 - sink_seconds, setup_seconds + busy / threads);
+  report.seconds = std::max(now_seconds() - t0 - sink_seconds, setup_seconds + busy / threads_used);
   return report;
 }
 

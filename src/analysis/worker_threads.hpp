@@ -18,4 +18,11 @@ namespace quadval {
 /// and returns when all have returned. @pre body does not throw; threads >= 1
 void run_on_threads(int threads, const std::function<void(int)>& body);
 
+/// The same, but the other threads start only when body(0) first calls the `more` it is
+/// given (later calls, and the no-op `more` of the other threads, do nothing), or never:
+/// for work whose size shows only once it is under way, as a started thread costs about
+/// 0.5 ms before it pays (its start, and the cold caches and memory it begins with).
+/// Returns the number of threads that ran body: threads, or 1.
+int run_on_threads_on_demand(int threads, const std::function<void(int, const std::function<void()>& more)>& body);
+
 }  // namespace quadval

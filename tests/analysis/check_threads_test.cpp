@@ -1,7 +1,8 @@
 // check_mesh's thread count: extra threads only for work worth them (each costs its wake-up
 // and the closing barrier, milliseconds on busy cores), and with several threads the
-// answers are those of one thread, bit for bit. The other determinism tests run meshes
-// small enough to stay on one thread; this one is large enough for two.
+// answers are those of one thread, bit for bit, whether the threads start at once or on
+// demand (mid-run). The other determinism tests run meshes small enough to stay on one
+// thread; this one is large enough for two.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -35,9 +36,14 @@ TEST(CheckThreads, LargeWorkUsesThreadsWithIdenticalAnswers) {
   o.threads = 1;
   const CheckReport one = check_mesh(mesh, o);
   o.threads = 8;  // capped by the work, not by the chunks (12)
+  o.threads_on_demand = false;
   const CheckReport many = check_mesh(mesh, o);
+  o.threads_on_demand = true;  // (started mid-run or not at all, as the machine's pace says)
+  const CheckReport on_demand = check_mesh(mesh, o);
   EXPECT_EQ(one.threads, 1);
   EXPECT_EQ(many.threads, 6);
+  EXPECT_TRUE(on_demand.threads == 1 || on_demand.threads == 6) << on_demand.threads;
+  EXPECT_EQ(check_csv(one), check_csv(on_demand));
   ASSERT_EQ(one.elements.size(), many.elements.size());
   std::size_t answers[3] = {0, 0, 0};
   for (std::size_t e = 0; e < one.elements.size(); ++e) {
@@ -65,6 +71,7 @@ TEST(CheckThreads, MeasuringCountsAsMoreWork) {
   const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 128, 3);
   CheckOptions o;
   o.threads = 8;
+  o.threads_on_demand = false;  // the estimate's count, not the pace of this machine
   o.measure = CheckMeasure::validity;
   EXPECT_EQ(check_mesh(small, o).threads, 1);
   o.measure = CheckMeasure::jacobian;
@@ -76,6 +83,20 @@ TEST(CheckThreads, MeasuringCountsAsMoreWork) {
   EXPECT_EQ(check_mesh(big, o).threads, 6);
   o.measure = CheckMeasure::jacobian;
   EXPECT_EQ(check_mesh(big, o).threads, 8);
+}
+
+TEST(CheckThreads, OnDemandStartsAtOnceForLargeEstimates) {
+  // 3000 tetrahedra of order 3 measured: 2.5e8 units, above the threshold of an immediate
+  // start (3e7), so the count is the estimate's whatever the pace: 8 requested.
+  const Mesh big = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 3000, 4);
+  CheckOptions o;
+  o.threads = 8;
+  o.measure = CheckMeasure::jacobian;
+  EXPECT_EQ(check_mesh(big, o).threads, 8);
+  // A tiny job: one thread (128 x 20 x 84 = 2.15e5 units, one thread's worth).
+  const Mesh small = random_mesh(*find_element_type(ElementFamily::tetrahedron, 3, true), 128, 3);
+  o.measure = CheckMeasure::validity;
+  EXPECT_EQ(check_mesh(small, o).threads, 1);
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 // run_on_threads: every index once, index 0 on the caller, the others on threads of their
 // own, which run with the caller's CPU affinity (placed on another CPU to start, never
-// left pinned there).
+// left pinned there). run_on_threads_on_demand: the others only once index 0 asks.
 #include <gtest/gtest.h>
 #include <pthread.h>
 #include <sched.h>
 
+#include <functional>
 #include <mutex>
 #include <set>
 #include <thread>
@@ -57,6 +58,36 @@ TEST(WorkerThreads, IndexZeroRunsOnTheCaller) {
     zero = std::this_thread::get_id();
   });
   EXPECT_EQ(zero, caller);
+}
+
+TEST(WorkerThreads, OnDemandRunsOthersOnlyWhenAsked) {
+  std::mutex m;
+  std::vector<int> calls(4, 0);
+  const auto count = [&](int t) {
+    const std::lock_guard<std::mutex> lock(m);
+    ++calls[static_cast<std::size_t>(t)];
+  };
+  // Never asked: index 0 alone.
+  EXPECT_EQ(run_on_threads_on_demand(4, [&](int t, const std::function<void()>&) { count(t); }), 1);
+  EXPECT_EQ(calls, (std::vector<int>{1, 0, 0, 0}));
+  // Asked (twice by index 0, and by the others, whose `more` does nothing): every index once.
+  calls.assign(4, 0);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::thread::id zero;
+  EXPECT_EQ(run_on_threads_on_demand(4,
+                                     [&](int t, const std::function<void()>& more) {
+                                       more();
+                                       more();
+                                       if (t == 0) zero = std::this_thread::get_id();
+                                       count(t);
+                                     }),
+            4);
+  EXPECT_EQ(calls, (std::vector<int>{1, 1, 1, 1}));
+  EXPECT_EQ(zero, caller);
+  // One thread: nothing to start.
+  calls.assign(4, 0);
+  EXPECT_EQ(run_on_threads_on_demand(1, [&](int t, const std::function<void()>& more) { more(); count(t); }), 1);
+  EXPECT_EQ(calls, (std::vector<int>{1, 0, 0, 0}));
 }
 
 }  // namespace
