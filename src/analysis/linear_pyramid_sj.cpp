@@ -15,6 +15,7 @@ namespace quadval {
 namespace {
 
 using edge_determinants::kW1;
+using edge_determinants::settled_lanes;
 
 constexpr double kUnit = 0x1p-53;
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -112,15 +113,7 @@ struct PyramidLanes {
     const L lo = lanes3::down<W>(space.s_lo() * lower * (1 - kSlack));
     const L hi = lanes3::up<W>(space.s_hi() * upper * (1 + kSlack));
     ok &= lanes3::up<W>(hi - lo) <= tol;
-    const unsigned done = lanes3::mask_bits<W>(ok);
-    for (int l = 0; l < W; ++l)
-      if (((done >> l) & 1u) != 0) {
-        out[l] = QualityBounds{};
-        out[l].lower = lo[l];
-        out[l].upper = hi[l];
-        out[l].tolerance_met = true;
-      }
-    return done;
+    return settled_lanes<W>(ok, lo, hi, out);
   }
 };
 

@@ -16,6 +16,7 @@ namespace quadval {
 namespace {
 
 using edge_determinants::kW1;
+using edge_determinants::settled_lanes;
 
 constexpr double kUnit = 0x1p-53;
 // Edges of 1-norm within [2^-100, 2^100]: every norm, square and product of six of them is
@@ -196,15 +197,7 @@ struct HexLanes {
           upper = den > 0 ? least(upper, up(up(j + widen(16 * kUnit * t)) / (den > 0 ? den : L{} + 1))) : upper;
         }
     ok &= up(upper - lower) <= tol;
-    const unsigned done = lanes3::mask_bits<W>(ok);
-    for (int l = 0; l < W; ++l)
-      if (((done >> l) & 1u) != 0) {
-        out[l] = QualityBounds{};
-        out[l].lower = lower[l];
-        out[l].upper = upper[l];
-        out[l].tolerance_met = true;
-      }
-    return done;
+    return settled_lanes<W>(ok, lower, upper, out);
   }
 };
 
