@@ -10,6 +10,7 @@
 // Results stream: elements are analysed in batches, CSV/JSON rows are written as each batch
 // finishes and VTU/MSH keep one double per element and field, so memory stays near the
 // mesh's own whatever its size (-v prints both).
+#include <omp.h>
 #include <sys/resource.h>
 #include <unistd.h>
 
@@ -77,6 +78,8 @@ int run_check(const CheckCliOptions& o) {
     if (e != ".csv" && e != ".json" && e != ".vtu" && e != ".msh")
       throw InputError::in_file(out, "unknown output extension (expected .csv, .json, .vtu or .msh)");
   }
+  // The reading of large ASCII files runs on OpenMP's threads too.
+  if (o.threads > 0) omp_set_num_threads(o.threads);
   std::vector<std::string> read_warnings;
   const Mesh mesh = read_mesh(o.input, &read_warnings);
   if (!o.quiet)  // --quiet prints nothing, warnings included

@@ -13,6 +13,7 @@
 #include <fmt/core.h>
 
 #include "io/msh_reader.hpp"
+#include "io/parallel_lines.hpp"
 #include "quadval/element_type.hpp"
 
 namespace quadval::io {
@@ -40,6 +41,19 @@ struct AsciiSource {
   void release_parsed() noexcept { in.release_parsed(); }
   [[noreturn]] void fail(const std::string& message) { in.fail_at_token(message); }
   std::size_t where() const { return static_cast<std::size_t>(in.line()); }
+  /// A large block's lines on several threads (parallel_lines.hpp); false: read them one
+  /// by one.
+  bool element_lines(std::uint64_t count, std::uint64_t nodes_each, const TagIndex& index, std::vector<Tag>& tags,
+                     std::vector<NodeIndex>& nodes) {
+    return read_element_lines(in, count, nodes_each, index, tags, nodes);
+  }
+  bool tag_lines(std::uint64_t count, std::vector<Tag>& tags) { return read_tag_lines(in, count, tags); }
+  bool coordinate_lines(std::uint64_t count, std::vector<double>& coords) {
+    return read_coordinate_lines(in, count, coords);
+  }
+  /// Moves back to `mark` (tag_lines' lines read again one by one).
+  TextCursor::Mark mark() const noexcept { return in.mark(); }
+  void rewind(const TextCursor::Mark& m) noexcept { in.rewind(m); }
 };
 
 /// Values from binary data; `size_bytes` is the width of a size_t field.
@@ -63,6 +77,13 @@ struct BinarySource {
   void release_parsed() noexcept { in.release_parsed(); }
   [[noreturn]] void fail(const std::string& message) { in.fail_at(in.last_position(), message); }
   std::size_t where() const { return in.position(); }
+  bool element_lines(std::uint64_t, std::uint64_t, const TagIndex&, std::vector<Tag>&, std::vector<NodeIndex>&) {
+    return false;
+  }
+  bool tag_lines(std::uint64_t, std::vector<Tag>&) { return false; }
+  bool coordinate_lines(std::uint64_t, std::vector<double>&) { return false; }
+  int mark() const noexcept { return 0; }
+  void rewind(int) noexcept {}
 };
 
 /// The type with this MSH id, which must have a fixed node count.
@@ -166,7 +187,22 @@ void read_nodes41(Src& src, MshReadState& state) {
                 8 * (4 + static_cast<std::uint64_t>(num_param)), "nodes");
     block.first = static_cast<std::size_t>(total);
     block.count = static_cast<std::size_t>(count);
-    for (std::uint64_t i = 0; i < count; ++i) {
+    // The tags of a large block read at once; a tag 0 or a repeated one is then reported
+    // from the lines read one by one again (the index rebuilt from the earlier blocks').
+    const auto tags_at = src.mark();
+    if (src.tag_lines(count, mesh.node_tags)) {
+      for (std::uint64_t i = 0; i < count; ++i) {
+        const std::uint64_t tag = mesh.node_tags[static_cast<std::size_t>(total + i)];
+        if (tag != 0 && state.node_index.insert(tag, static_cast<std::uint32_t>(total + i))) continue;
+        mesh.node_tags.resize(static_cast<std::size_t>(total));
+        state.node_index = TagIndex(num_nodes);
+        for (std::uint64_t k = 0; k < total; ++k)
+          state.node_index.insert(mesh.node_tags[static_cast<std::size_t>(k)], static_cast<std::uint32_t>(k));
+        src.rewind(tags_at);
+        break;
+      }
+    }
+    for (std::uint64_t i = mesh.node_tags.size() - total; i < count; ++i) {
       const std::uint64_t tag = src.size("node tag");
       if (tag == 0) src.fail("node tag 0, expected a tag >= 1");
       if (!state.node_index.insert(tag, static_cast<std::uint32_t>(total + i)))
@@ -174,7 +210,8 @@ void read_nodes41(Src& src, MshReadState& state) {
       mesh.node_tags.push_back(tag);
       src.release_parsed();
     }
-    for (std::uint64_t i = 0; i < count; ++i) {
+    const bool coordinates_read = num_param == 0 && src.coordinate_lines(count, mesh.coords);
+    for (std::uint64_t i = 0; i < count && !coordinates_read; ++i) {
       mesh.coords.push_back(src.real("node x coordinate"));
       mesh.coords.push_back(src.real("node y coordinate"));
       mesh.coords.push_back(src.real("node z coordinate"));
@@ -220,7 +257,8 @@ void read_elements41(Src& src, MshReadState& state) {
     block.tags.reserve(static_cast<std::size_t>(count));
     block.nodes.reserve(static_cast<std::size_t>(count * nn));
     const std::string what = fmt::format("an element tag and {} node tags ({})", nn, block.type->name);
-    for (std::uint64_t e = 0; e < count; ++e) {
+    const bool lines_read = src.element_lines(count, nn, state.node_index, block.tags, block.nodes);
+    for (std::uint64_t e = 0; e < count && !lines_read; ++e) {
       src.begin_record();
       const std::uint64_t tag = src.size("element tag");
       block.tags.push_back(tag);

@@ -6,6 +6,7 @@ list(APPEND QUADVAL_SOURCES
   src/io/msh_read_ascii.cpp
   src/io/msh_read_binary.cpp
   src/io/msh_write.cpp
+  src/io/parallel_lines.cpp
   src/io/surface_read.cpp
   src/io/vtk_node_order.cpp
   src/io/vtu_write.cpp

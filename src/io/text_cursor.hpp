@@ -40,6 +40,23 @@ class TextCursor {
     for (std::size_t i = pos_; i < pos; ++i) line_ += data_[i] == '\n';
     pos_ = pos;
   }
+  /// A position to come back to (rewind), with its line.
+  struct Mark {
+    std::size_t pos;
+    long line;
+  };
+  Mark mark() const noexcept { return {pos_, line_}; }
+  /// Back to `m` (bytes given back by release_parsed come again from the file: a read-only
+  /// private mapping, FileBytes).
+  void rewind(const Mark& m) noexcept {
+    pos_ = m.pos;
+    line_ = m.line;
+  }
+  /// Moves forward to `pos`, which is `line_ends` line ends further (known to the caller).
+  void skip_lines_to(std::size_t pos, long line_ends) noexcept {
+    pos_ = pos;
+    line_ += line_ends;
+  }
   /// Errors name byte offsets from now on (the ASCII parts of a binary file).
   void report_offsets() noexcept { offsets_only_ = true; }
 

@@ -1,0 +1,179 @@
+// Large blocks' element and coordinate lines on several threads (see the header).
+#include "io/parallel_lines.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <system_error>
+#include <utility>
+
+namespace quadval::io {
+namespace {
+
+// TextCursor::is_space without the line end.
+bool is_blank(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+// The next blank-separated token of [p, last), p moved past it; empty at the line's end.
+std::pair<const char*, const char*> next_token(const char*& p, const char* last) noexcept {
+  while (p < last && is_blank(*p)) ++p;
+  const char* first = p;
+  while (p < last && !is_blank(*p)) ++p;
+  return {first, p};
+}
+
+// TextCursor::unsigned_integer's number: the whole token, digits only.
+bool next_unsigned(const char*& p, const char* last, std::uint64_t& v) noexcept {
+  const auto [first, end] = next_token(p, last);
+  if (first == end) return false;
+  const auto [ptr, ec] = std::from_chars(first, end, v);
+  return ec == std::errc() && ptr == end;
+}
+
+// TextCursor::real's number: an optional '+', then the whole token, finite.
+bool next_real(const char*& p, const char* last, double& v) noexcept {
+  auto [first, end] = next_token(p, last);
+  if (first < end && *first == '+') ++first;
+  if (first == end) return false;
+  const auto [ptr, ec] = std::from_chars(first, end, v);
+  return ec == std::errc() && ptr == end && std::isfinite(v);
+}
+
+bool only_blanks(const char* p, const char* last) noexcept {
+  while (p < last && is_blank(*p)) ++p;
+  return p == last;
+}
+
+// [begin, end) of the `count` lines after the cursor's line, whose rest must be blank:
+// begin after its line end, end after the count-th line end from there.
+std::optional<std::pair<std::size_t, std::size_t>> next_lines(const TextCursor& in, std::uint64_t count) {
+  const std::string_view data = in.data();
+  std::size_t p = in.position();
+  while (p < data.size() && is_blank(data[p])) ++p;
+  if (p >= data.size() || data[p] != '\n') return std::nullopt;
+  const std::size_t begin = p + 1;
+  // Line ends counted a block at a time (a vectorised count), then found one by one in
+  // the block that holds the last.
+  constexpr std::size_t kBlock = std::size_t{1} << 16;
+  std::size_t at = begin;
+  std::uint64_t left = count;
+  while (left > 0) {
+    if (at >= data.size()) return std::nullopt;
+    const std::size_t stop = std::min(data.size(), at + kBlock);
+    const auto ends = static_cast<std::uint64_t>(std::count(data.data() + at, data.data() + stop, '\n'));
+    if (ends < left) {
+      left -= ends;
+      at = stop;
+      continue;
+    }
+    for (; left > 0; --left)
+      at = static_cast<std::size_t>(static_cast<const char*>(std::memchr(data.data() + at, '\n', stop - at)) - data.data()) + 1;
+  }
+  return std::pair{begin, at};
+}
+
+// Calls parse(first, last, i) for line i (0 .. count - 1, [first, last) without its line
+// end) of the `count` lines after the cursor's line, the lines cut into one run per
+// thread; true when every call returned true, the cursor then at the end of the last line
+// (before its line end), where reading its last value one by one leaves it.
+template <class Parse>
+bool parse_lines(TextCursor& in, std::uint64_t count, const Parse& parse) {
+  if (count < kParallelLines) return false;
+  const auto run = next_lines(in, count);
+  if (!run) return false;
+  const auto [begin, end] = *run;
+  const char* base = in.data().data();
+  const auto pieces = static_cast<std::size_t>(
+      std::clamp<std::uint64_t>(count / kParallelLines, 1, static_cast<std::uint64_t>(std::max(1, omp_get_max_threads()))));
+  // Cuts at line starts, about equal in bytes.
+  std::vector<std::size_t> cut(pieces + 1, end);
+  cut[0] = begin;
+  for (std::size_t k = 1; k < pieces; ++k) {
+    const std::size_t at = std::max(cut[k - 1], begin + (end - begin) / pieces * k);
+    const void* line_end = std::memchr(base + at, '\n', end - at);
+    cut[k] = line_end == nullptr ? end : static_cast<std::size_t>(static_cast<const char*>(line_end) - base) + 1;
+  }
+  std::vector<std::uint64_t> first_line(pieces + 1, 0);
+  std::atomic<bool> ok{true};
+#pragma omp parallel num_threads(static_cast<int>(pieces))
+  {
+#pragma omp for schedule(static, 1)
+    for (std::size_t k = 0; k < pieces; ++k)
+      first_line[k + 1] = static_cast<std::uint64_t>(std::count(base + cut[k], base + cut[k + 1], '\n'));
+#pragma omp single
+    for (std::size_t k = 0; k < pieces; ++k) first_line[k + 1] += first_line[k];
+#pragma omp for schedule(static, 1)
+    for (std::size_t k = 0; k < pieces; ++k) {
+      std::uint64_t i = first_line[k];
+      for (const char* p = base + cut[k]; p < base + cut[k + 1] && ok.load(std::memory_order_relaxed); ++i) {
+        const char* line_end = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(base + cut[k + 1] - p)));
+        if (!parse(p, line_end, i)) ok.store(false, std::memory_order_relaxed);
+        p = line_end + 1;
+      }
+    }
+  }
+  if (!ok.load()) return false;
+  in.skip_lines_to(end - 1, static_cast<long>(count));
+  in.release_parsed();
+  return true;
+}
+
+}  // namespace
+
+bool read_element_lines(TextCursor& in, std::uint64_t count, std::uint64_t nodes_each, const TagIndex& index,
+                        std::vector<Tag>& tags, std::vector<NodeIndex>& nodes) {
+  if (count < kParallelLines) return false;
+  const std::size_t tags_before = tags.size(), nodes_before = nodes.size();
+  tags.resize(tags_before + count);
+  nodes.resize(nodes_before + count * nodes_each);
+  Tag* tag_out = tags.data() + tags_before;
+  NodeIndex* node_out = nodes.data() + nodes_before;
+  const bool ok = parse_lines(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    if (!next_unsigned(p, last, tag_out[i])) return false;
+    NodeIndex* out = node_out + i * nodes_each;
+    for (std::uint64_t k = 0; k < nodes_each; ++k) {
+      std::uint64_t node_tag = 0;
+      if (!next_unsigned(p, last, node_tag)) return false;
+      out[k] = index.find(node_tag);
+      if (out[k] == TagIndex::kMissing) return false;
+    }
+    return only_blanks(p, last);
+  });
+  if (!ok) {
+    tags.resize(tags_before);
+    nodes.resize(nodes_before);
+  }
+  return ok;
+}
+
+bool read_tag_lines(TextCursor& in, std::uint64_t count, std::vector<Tag>& tags) {
+  if (count < kParallelLines) return false;
+  const std::size_t before = tags.size();
+  tags.resize(before + count);
+  Tag* out = tags.data() + before;
+  const bool ok = parse_lines(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    return next_unsigned(p, last, out[i]) && only_blanks(p, last);
+  });
+  if (!ok) tags.resize(before);
+  return ok;
+}
+
+bool read_coordinate_lines(TextCursor& in, std::uint64_t count, std::vector<double>& coords) {
+  if (count < kParallelLines) return false;
+  const std::size_t before = coords.size();
+  coords.resize(before + 3 * count);
+  double* out = coords.data() + before;
+  const bool ok = parse_lines(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    double* xyz = out + 3 * i;
+    return next_real(p, last, xyz[0]) && next_real(p, last, xyz[1]) && next_real(p, last, xyz[2]) &&
+           only_blanks(p, last);
+  });
+  if (!ok) coords.resize(before);
+  return ok;
+}
+
+}  // namespace quadval::io
