@@ -2,7 +2,12 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstring>
+#include <map>
+#include <random>
+
+#include <fmt/core.h>
 
 #include "io/io_test_support.hpp"
 #include "quadval/error.hpp"
@@ -48,6 +53,59 @@ TEST(SurfaceRead, AsciiStlMergesIdenticalVertices) {
   EXPECT_EQ(m.blocks[0].type->gmsh_id, 2);
   EXPECT_EQ(m.blocks[0].nodes, (std::vector<NodeIndex>{0, 1, 2, 0, 2, 3}));  // -0 is 0
   EXPECT_EQ(m.blocks[0].tags, (std::vector<Tag>{1, 2}));
+}
+
+// Many vertices (the merger's table grows several times), in a random order with repeats
+// and -0.0 for some zeros: nodes numbered by first appearance, equal values merged, as an
+// ordered map of the values finds them; binary and ASCII alike.
+TEST(SurfaceRead, StlMergesThousandsOfVerticesInOrderOfFirstAppearance) {
+  ScratchDir dir("stl_many");
+  std::mt19937_64 rng(5);
+  const int distinct = 5000, facets = 6000;
+  std::vector<std::array<float, 3>> points(distinct);
+  for (auto& p : points)
+    for (float& c : p) c = static_cast<float>(rng() % 200) * 0.25f;  // many equal coordinates
+  std::vector<std::array<float, 3>> corners;
+  for (int f = 0; f < 3 * facets; ++f) {
+    std::array<float, 3> p = points[rng() % distinct];
+    for (float& c : p)
+      if (c == 0 && rng() % 2 == 0) c = -0.0f;
+    corners.push_back(p);
+  }
+  // The expected numbering, from an ordered map of the values (-0 and 0 the same key).
+  std::map<std::array<double, 3>, NodeIndex> first;
+  std::vector<NodeIndex> expected_nodes;
+  std::vector<double> expected_coords;
+  for (const auto& p : corners) {
+    const std::array<double, 3> key{p[0] + 0.0, p[1] + 0.0, p[2] + 0.0};
+    const auto [it, added] = first.emplace(key, static_cast<NodeIndex>(first.size()));
+    if (added) expected_coords.insert(expected_coords.end(), {double{p[0]}, double{p[1]}, double{p[2]}});
+    expected_nodes.push_back(it->second);
+  }
+  std::string binary(80, ' ');
+  const auto count = static_cast<std::uint32_t>(facets);
+  binary.append(reinterpret_cast<const char*>(&count), 4);
+  std::string ascii = "solid many\n";
+  for (int f = 0; f < facets; ++f) {
+    const float normal[3] = {0, 0, 1};
+    binary.append(reinterpret_cast<const char*>(normal), 12);
+    ascii += "facet normal 0 0 1\nouter loop\n";
+    for (int k = 0; k < 3; ++k) {
+      const auto& p = corners[static_cast<std::size_t>(3 * f + k)];
+      binary.append(reinterpret_cast<const char*>(p.data()), 12);
+      ascii += fmt::format("vertex {} {} {}\n", p[0], p[1], p[2]);
+    }
+    binary.append(2, '\0');
+    ascii += "endloop\nendfacet\n";
+  }
+  ascii += "endsolid many\n";
+  for (const auto& [name, text] : {std::pair{"b.stl", binary}, std::pair{"a.stl", ascii}}) {
+    const Mesh m = read_text(dir, name, text);
+    ASSERT_EQ(m.blocks.size(), 1u) << name;
+    EXPECT_EQ(m.blocks[0].nodes, expected_nodes) << name;
+    ASSERT_EQ(m.coords.size(), expected_coords.size()) << name;
+    for (std::size_t i = 0; i < m.coords.size(); ++i) EXPECT_EQ(m.coords[i], expected_coords[i]) << name << " " << i;
+  }
 }
 
 TEST(SurfaceRead, BinaryStlEvenWithASolidHeader) {
