@@ -98,11 +98,17 @@ class VertexMerger {
 
  private:
   static constexpr NodeIndex kEmpty = 0xffffffffu;
+  // SplitMix64's finaliser: every bit of the input reaches the low bits that index the
+  // slots (coordinates read from float have their low 29 mantissa bits zero).
+  static std::uint64_t mix(std::uint64_t z) noexcept {
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  }
   static std::size_t hash(double x, double y, double z) noexcept {
-    std::uint64_t h = std::bit_cast<std::uint64_t>(x + 0.0) * 0x9E3779B97F4A7C15ull;
-    h ^= (std::bit_cast<std::uint64_t>(y + 0.0) + 0x632BE59BD9B4E019ull + (h << 6) + (h >> 2)) * 0xC2B2AE3D27D4EB4Full;
-    h ^= (std::bit_cast<std::uint64_t>(z + 0.0) + 0x165667B19E3779F9ull + (h << 6) + (h >> 2)) * 0x9E3779B97F4A7C15ull;
-    return static_cast<std::size_t>(h ^ (h >> 29));
+    const std::uint64_t h = mix(std::bit_cast<std::uint64_t>(x + 0.0) +
+                                mix(std::bit_cast<std::uint64_t>(y + 0.0) + mix(std::bit_cast<std::uint64_t>(z + 0.0))));
+    return static_cast<std::size_t>(h);
   }
   // Twice the slots, every node placed again (at most half full before).
   void grow() {
