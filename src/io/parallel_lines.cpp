@@ -5,46 +5,45 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
-#include <cmath>
 #include <cstring>
 #include <optional>
-#include <system_error>
+#include <string_view>
 #include <utility>
 
 namespace quadval::io {
 namespace {
 
-// TextCursor::is_space without the line end.
-bool is_blank(char c) noexcept { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+// Token separators within a line: TextCursor::is_space but the line end.
+bool is_blank(char c) noexcept { return c != '\n' && TextCursor::is_space(c); }
 
 // The next blank-separated token of [p, last), p moved past it; empty at the line's end.
-std::pair<const char*, const char*> next_token(const char*& p, const char* last) noexcept {
+std::string_view next_token(const char*& p, const char* last) noexcept {
   while (p < last && is_blank(*p)) ++p;
   const char* first = p;
   while (p < last && !is_blank(*p)) ++p;
-  return {first, p};
+  return {first, static_cast<std::size_t>(p - first)};
 }
 
-// TextCursor::unsigned_integer's number: the whole token, digits only.
 bool next_unsigned(const char*& p, const char* last, std::uint64_t& v) noexcept {
-  const auto [first, end] = next_token(p, last);
-  if (first == end) return false;
-  const auto [ptr, ec] = std::from_chars(first, end, v);
-  return ec == std::errc() && ptr == end;
+  const std::string_view t = next_token(p, last);
+  return !t.empty() && TextCursor::parse_unsigned(t, v);
 }
 
-// TextCursor::real's number: an optional '+', then the whole token, finite.
 bool next_real(const char*& p, const char* last, double& v) noexcept {
-  auto [first, end] = next_token(p, last);
-  if (first < end && *first == '+') ++first;
-  if (first == end) return false;
-  const auto [ptr, ec] = std::from_chars(first, end, v);
-  return ec == std::errc() && ptr == end && std::isfinite(v);
+  const std::string_view t = next_token(p, last);
+  return !t.empty() && TextCursor::parse_real(t, v) == TextCursor::RealToken::ok;
 }
 
+// Nothing but token separators up to the line's end (tag and coordinate lines are read
+// token by token, across line ends).
 bool only_blanks(const char* p, const char* last) noexcept {
   while (p < last && is_blank(*p)) ++p;
+  return p == last;
+}
+
+// Only what TextCursor::end_record allows after a record's last value (element lines).
+bool record_ends(const char* p, const char* last) noexcept {
+  while (p < last && TextCursor::is_trailing_blank(*p)) ++p;
   return p == last;
 }
 
@@ -141,7 +140,7 @@ bool read_element_lines(TextCursor& in, std::uint64_t count, std::uint64_t nodes
       out[k] = index.find(node_tag);
       if (out[k] == TagIndex::kMissing) return false;
     }
-    return only_blanks(p, last);
+    return record_ends(p, last);
   });
   if (!ok) {
     tags.resize(tags_before);

@@ -8,7 +8,8 @@
 // missing value, an unknown node tag, a record across lines) it gives up, leaving the
 // cursor and the output as they were, and the caller parses the lines one by one as
 // before, which reports the error with its line. So what is accepted and every message
-// stay as they were; the values are the same numbers (std::from_chars, as TextCursor).
+// stay as they were; values are read by TextCursor's own token rules
+// (parse_unsigned, parse_real, is_trailing_blank at a record's end).
 
 #include <cstdint>
 #include <vector>

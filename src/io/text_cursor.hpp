@@ -117,8 +117,7 @@ class TextCursor {
   std::uint64_t unsigned_integer(std::string_view what) {
     std::string_view t = token(what);
     std::uint64_t v = 0;
-    auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
-    if (ec != std::errc() || ptr != t.data() + t.size())
+    if (!parse_unsigned(t, v))
       fail_at_token("expected " + std::string(what) + " (a non-negative integer), found '" +
                     shorten(t) + "'");
     return v;
@@ -127,18 +126,35 @@ class TextCursor {
   /// A finite floating-point number.
   double real(std::string_view what) {
     std::string_view t = token(what);
+    double v = 0;
+    switch (parse_real(t, v)) {
+      case RealToken::ok: return v;
+      case RealToken::out_of_range:
+        fail_at_token(std::string(what) + " '" + shorten(t) + "' is out of the range of double");
+      case RealToken::not_a_number:
+        fail_at_token("expected " + std::string(what) + " (a number), found '" + shorten(t) + "'");
+      case RealToken::not_finite: break;
+    }
+    fail_at_token(std::string(what) + " is '" + shorten(t) + "', expected a finite number");
+  }
+
+  /// How unsigned_integer reads a token: all of it, digits only. (Shared with the
+  /// parallel reader, parallel_lines.hpp, which must accept exactly what this does.)
+  static bool parse_unsigned(std::string_view t, std::uint64_t& v) noexcept {
+    const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    return ec == std::errc() && ptr == t.data() + t.size();
+  }
+  /// How real reads a token: an optional '+' (from_chars rejects it), then all of it, a
+  /// finite double.
+  enum class RealToken { ok, not_a_number, out_of_range, not_finite };
+  static RealToken parse_real(std::string_view t, double& v) noexcept {
     const char* first = t.data();
     const char* last = t.data() + t.size();
-    if (first < last && *first == '+') ++first;  // from_chars rejects a leading '+'
-    double v = 0;
-    auto [ptr, ec] = std::from_chars(first, last, v);
-    if (ec == std::errc::result_out_of_range)
-      fail_at_token(std::string(what) + " '" + shorten(t) + "' is out of the range of double");
-    if (ec != std::errc() || ptr != last)
-      fail_at_token("expected " + std::string(what) + " (a number), found '" + shorten(t) + "'");
-    if (!std::isfinite(v))
-      fail_at_token(std::string(what) + " is '" + shorten(t) + "', expected a finite number");
-    return v;
+    if (first < last && *first == '+') ++first;
+    const auto [ptr, ec] = std::from_chars(first, last, v);
+    if (ec == std::errc::result_out_of_range) return RealToken::out_of_range;
+    if (ec != std::errc() || ptr != last) return RealToken::not_a_number;
+    return std::isfinite(v) ? RealToken::ok : RealToken::not_finite;
   }
 
   /// The rest of the current line (without the line end); moves to the next line.
@@ -155,8 +171,7 @@ class TextCursor {
   /// Consumes blanks up to and including the next line end; fails if anything else is on
   /// the line. Used before binary data, which starts right after the line end.
   void finish_line(std::string_view what) {
-    while (pos_ < data_.size() && (data_[pos_] == ' ' || data_[pos_] == '\t' || data_[pos_] == '\r'))
-      ++pos_;
+    while (pos_ < data_.size() && is_trailing_blank(data_[pos_])) ++pos_;
     if (pos_ >= data_.size()) fail_here("unexpected end of file, expected a line end before " + std::string(what));
     if (data_[pos_] != '\n') fail_here("expected a line end before " + std::string(what) + ", found '" + shorten(data_.substr(pos_, 20)) + "'");
     ++pos_;
@@ -181,7 +196,7 @@ class TextCursor {
     if (line_ != record_line_)
       fail_line(record_line_, "too few values on the line, expected " + std::string(what));
     std::size_t p = pos_;
-    while (p < data_.size() && (data_[p] == ' ' || data_[p] == '\t' || data_[p] == '\r')) ++p;
+    while (p < data_.size() && is_trailing_blank(data_[p])) ++p;
     if (p < data_.size() && data_[p] != '\n') {
       token_line_ = line_;
       fail_at_token("too many values on the line, expected " + std::string(what));
@@ -215,6 +230,8 @@ class TextCursor {
   static bool is_space(char c) noexcept {
     return c == ' ' || c == '\n' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
   }
+  /// What end_record and finish_line allow after a line's last value.
+  static bool is_trailing_blank(char c) noexcept { return c == ' ' || c == '\t' || c == '\r'; }
 
  private:
   std::string_view data_;

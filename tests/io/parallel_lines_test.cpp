@@ -165,6 +165,8 @@ TEST(ParallelLines, ErrorsNameTheirLineInsideAndAfterLargeBlocks) {
               at(quad_line, "element 5 refers to node tag 7, which is not in $Nodes"));
   EXPECT_THAT(with(quad_line, "5 1000 1001 1002"), at(quad_line, "too few values on the line"));
   EXPECT_THAT(with(quad_line, "5 1000 1001 1002 1003 1004"), at(quad_line, "too many values on the line"));
+  // A vertical tab separates values but may not end a record (TextCursor::end_record).
+  EXPECT_THAT(with(quad_line, big.lines[quad_line - 1] + "\v"), at(quad_line, "too many values on the line"));
   EXPECT_THAT(with(big.end_elements_line, "$EndElementz"), at(big.end_elements_line, "expected $EndElements"));
   // One value too many at the end of the tags: the coordinates take it, and one of theirs
   // is left where $EndNodes should be.
