@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <stdexcept>
 
 #include "io/out_buffer.hpp"
@@ -120,9 +121,11 @@ class MshWriter {
         out_.bytes(mesh_.coords.data() + 3 * b.first, 3 * b.count * sizeof(double));
       } else {
         out_.text("{} {} 0 {}\n", b.entity_dim, b.entity_tag, b.count);
-        for (std::size_t i = b.first; i < b.first + b.count; ++i) out_.text("{}\n", mesh_.node_tags[i]);
-        for (std::size_t i = b.first; i < b.first + b.count; ++i)
-          out_.text("{} {} {}\n", mesh_.coords[3 * i], mesh_.coords[3 * i + 1], mesh_.coords[3 * i + 2]);
+        for (std::size_t i = b.first; i < b.first + b.count; ++i) {
+          out_.integer(mesh_.node_tags[i]);
+          out_.put('\n');
+        }
+        for (std::size_t i = b.first; i < b.first + b.count; ++i) coordinates(i);
       }
     }
     end_section("Nodes");
@@ -159,9 +162,8 @@ class MshWriter {
           for (NodeIndex v : b.element(e)) record.push_back(mesh_.node_tags[v]);
           out_.bytes_buffered(record.data(), record.size() * sizeof(std::uint64_t));
         } else {
-          out_.text("{}", b.tags[e]);
-          for (NodeIndex v : b.element(e)) out_.text(" {}", mesh_.node_tags[v]);
-          out_.text("\n");
+          out_.integer(b.tags[e]);
+          node_tags(b.element(e));
         }
       }
     }
@@ -176,7 +178,9 @@ class MshWriter {
         out_.raw(tag);
         out_.bytes_buffered(mesh_.coords.data() + 3 * i, 3 * sizeof(double));
       } else {
-        out_.text("{} {} {} {}\n", tag, mesh_.coords[3 * i], mesh_.coords[3 * i + 1], mesh_.coords[3 * i + 2]);
+        out_.integer(tag);
+        out_.put(' ');
+        coordinates(i);
       }
     }
     end_section("Nodes");
@@ -217,8 +221,7 @@ class MshWriter {
             out_.bytes_buffered(record.data(), record.size() * sizeof(std::int32_t));
           } else {
             out_.text("{} {} 2 {} {}", tag, block.type->gmsh_id, physical, elementary);
-            for (NodeIndex v : block.element(e)) out_.text(" {}", mesh_.node_tags[v]);
-            out_.text("\n");
+            node_tags(block.element(e));
           }
         }
       }
@@ -238,7 +241,10 @@ class MshWriter {
           out_.raw(int_tag(t, "element"));
           out_.raw(field.values[i]);
         } else {
-          out_.text("{} {}\n", t, field.values[i]);
+          out_.integer(t);
+          out_.put(' ');
+          out_.real(field.values[i]);
+          out_.put('\n');
         }
         ++i;
       }
@@ -247,6 +253,24 @@ class MshWriter {
   }
 
   void finish() { out_.flush(); }
+
+  // " tag tag ... tag\n" of the element's nodes.
+  void node_tags(std::span<const NodeIndex> element) {
+    for (NodeIndex v : element) {
+      out_.put(' ');
+      out_.integer(mesh_.node_tags[v]);
+    }
+    out_.put('\n');
+  }
+  // "x y z\n" of node i.
+  void coordinates(std::size_t i) {
+    out_.real(mesh_.coords[3 * i]);
+    out_.put(' ');
+    out_.real(mesh_.coords[3 * i + 1]);
+    out_.put(' ');
+    out_.real(mesh_.coords[3 * i + 2]);
+    out_.put('\n');
+  }
 
  private:
   void end_section(std::string_view name) { out_.text("{}$End{}\n", binary_ ? "\n" : "", name); }
