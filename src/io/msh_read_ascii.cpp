@@ -31,6 +31,10 @@ void read_elements22_ascii(TextCursor& in, MshReadState& state) {
   state.elements22.reserve(static_cast<std::size_t>(count));
   state.nodes22_offset.reserve(static_cast<std::size_t>(count));
   state.positions22.reserve(static_cast<std::size_t>(count));
+  if (read_element22_lines(in, count, state)) {
+    state.have_elements = true;
+    return;
+  }
   for (std::uint64_t e = 0; e < count; ++e) {
     src.begin_record();
     const std::int32_t tag = src.int32("element tag");

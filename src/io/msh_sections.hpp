@@ -51,6 +51,9 @@ struct AsciiSource {
   bool coordinate_lines(std::uint64_t count, std::vector<double>& coords) {
     return read_coordinate_lines(in, count, coords);
   }
+  bool node22_lines(std::uint64_t count, std::vector<Tag>& tags, std::vector<double>& coords) {
+    return read_node22_lines(in, count, tags, coords);
+  }
   /// Moves back to `mark` (tag_lines' lines read again one by one).
   TextCursor::Mark mark() const noexcept { return in.mark(); }
   void rewind(const TextCursor::Mark& m) noexcept { in.rewind(m); }
@@ -82,6 +85,7 @@ struct BinarySource {
   }
   bool tag_lines(std::uint64_t, std::vector<Tag>&) { return false; }
   bool coordinate_lines(std::uint64_t, std::vector<double>&) { return false; }
+  bool node22_lines(std::uint64_t, std::vector<Tag>&, std::vector<double>&) { return false; }
   int mark() const noexcept { return 0; }
   void rewind(int) noexcept {}
 };
@@ -285,6 +289,23 @@ void read_nodes22(Src& src, MshReadState& state, std::uint64_t num_nodes) {
   mesh.node_tags.reserve(static_cast<std::size_t>(num_nodes));
   mesh.coords.reserve(3 * static_cast<std::size_t>(num_nodes));
   state.node_index = TagIndex(num_nodes);
+  // A large section read at once; a repeated tag is then reported from the lines read one by
+  // one again.
+  const std::size_t tags_before = mesh.node_tags.size(), coords_before = mesh.coords.size();
+  const auto at = src.mark();
+  if (src.node22_lines(num_nodes, mesh.node_tags, mesh.coords)) {
+    bool unique = true;
+    for (std::uint64_t i = 0; i < num_nodes && unique; ++i)
+      unique = state.node_index.insert(mesh.node_tags[tags_before + i], static_cast<std::uint32_t>(i));
+    if (unique) {
+      state.have_nodes = true;
+      return;
+    }
+    mesh.node_tags.resize(tags_before);
+    mesh.coords.resize(coords_before);
+    state.node_index = TagIndex(num_nodes);
+    src.rewind(at);
+  }
   for (std::uint64_t i = 0; i < num_nodes; ++i) {
     src.begin_record();
     const std::int32_t tag = src.int32("node tag");

@@ -10,6 +10,8 @@
 #include <string_view>
 #include <utility>
 
+#include "quadval/element_type.hpp"
+
 namespace quadval::io {
 namespace {
 
@@ -77,13 +79,12 @@ std::optional<std::pair<std::size_t, std::size_t>> next_lines(const TextCursor& 
 
 // Calls parse(first, last, i) for line i (0 .. count - 1, [first, last) without its line
 // end) of the `count` lines after the cursor's line, the lines cut into one run per
-// thread; true when every call returned true, the cursor then at the end of the last line
-// (before its line end), where reading its last value one by one leaves it.
+// thread; the end of those lines when every call returned true. The cursor stays.
 template <class Parse>
-bool parse_lines(TextCursor& in, std::uint64_t count, const Parse& parse) {
-  if (count < kParallelLines) return false;
+std::optional<std::size_t> parse_lines_here(const TextCursor& in, std::uint64_t count, const Parse& parse) {
+  if (count < kParallelLines) return std::nullopt;
   const auto run = next_lines(in, count);
-  if (!run) return false;
+  if (!run) return std::nullopt;
   const auto [begin, end] = *run;
   const char* base = in.data().data();
   const auto pieces = static_cast<std::size_t>(
@@ -115,9 +116,49 @@ bool parse_lines(TextCursor& in, std::uint64_t count, const Parse& parse) {
       }
     }
   }
-  if (!ok.load()) return false;
-  in.skip_lines_to(end - 1, static_cast<long>(count));
+  if (!ok.load()) return std::nullopt;
+  return end;
+}
+
+// The same, and then the cursor at the end of the last line (before its line end), where
+// reading its last value one by one leaves it.
+template <class Parse>
+bool parse_lines(TextCursor& in, std::uint64_t count, const Parse& parse) {
+  const auto end = parse_lines_here(in, count, parse);
+  if (!end) return false;
+  in.skip_lines_to(*end - 1, static_cast<long>(count));
   in.release_parsed();
+  return true;
+}
+
+// A positive MSH 2.2 int (what AsciiSource::int32 reads, within [1, 2^31 - 1]).
+bool next_positive_int(const char*& p, const char* last, std::uint64_t& v) noexcept {
+  return next_unsigned(p, last, v) && v >= 1 && v <= 0x7fffffffu;
+}
+
+// The head of a MSH 2.2 element line: "tag type number-of-tags tags...", all positive but
+// the count of tags (0 to 1000, as read_element22_tags allows) and the tags (>= 0).
+struct Element22Head {
+  std::uint64_t tag = 0;
+  const ElementType* type = nullptr;
+  int physical = 0, elementary = 0;
+  bool partitions = false;  // more than two tags
+};
+bool next_element22_head(const char*& p, const char* last, Element22Head& h) noexcept {
+  std::uint64_t id = 0, num_tags = 0;
+  if (!next_positive_int(p, last, h.tag) || !next_positive_int(p, last, id) || id > 1000 ||
+      !next_unsigned(p, last, num_tags) || num_tags > 1000)
+    return false;
+  h.type = find_element_type(static_cast<int>(id));
+  if (h.type == nullptr || h.type->num_nodes == 0) return false;
+  h.physical = h.elementary = 0;
+  for (std::uint64_t k = 0; k < num_tags; ++k) {
+    std::uint64_t v = 0;
+    if (!next_unsigned(p, last, v) || v > 0x7fffffffu) return false;
+    if (k == 0) h.physical = static_cast<int>(v);
+    if (k == 1) h.elementary = static_cast<int>(v);
+  }
+  h.partitions = num_tags > 2;
   return true;
 }
 
@@ -173,6 +214,81 @@ bool read_coordinate_lines(TextCursor& in, std::uint64_t count, std::vector<doub
   });
   if (!ok) coords.resize(before);
   return ok;
+}
+
+bool read_node22_lines(TextCursor& in, std::uint64_t count, std::vector<Tag>& tags, std::vector<double>& coords) {
+  if (count < kParallelLines) return false;
+  const std::size_t tags_before = tags.size(), coords_before = coords.size();
+  tags.resize(tags_before + count);
+  coords.resize(coords_before + 3 * count);
+  Tag* tag_out = tags.data() + tags_before;
+  double* xyz_out = coords.data() + coords_before;
+  const bool ok = parse_lines(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    double* xyz = xyz_out + 3 * i;
+    return next_positive_int(p, last, tag_out[i]) && next_real(p, last, xyz[0]) && next_real(p, last, xyz[1]) &&
+           next_real(p, last, xyz[2]) && record_ends(p, last);
+  });
+  if (!ok) {
+    tags.resize(tags_before);
+    coords.resize(coords_before);
+  }
+  return ok;
+}
+
+bool read_element22_lines(TextCursor& in, std::uint64_t count, MshReadState& state) {
+  if (count < kParallelLines) return false;
+  // Two passes, as the node count of a line shows only from its type: the heads and node
+  // counts, then (at offsets summed in between) the nodes.
+  const std::size_t before = state.elements22.size(), nodes_before = state.nodes22.size();
+  state.elements22.resize(before + count);
+  state.positions22.resize(before + count);
+  std::vector<std::size_t> offset(count + 1, 0);
+  Msh22Element* element_out = state.elements22.data() + before;
+  std::atomic<bool> partitions{false};
+  const auto restore = [&] {
+    state.elements22.resize(before);
+    state.positions22.resize(before);
+    state.nodes22.resize(nodes_before);
+    return false;
+  };
+  const bool heads = parse_lines_here(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    Element22Head h;
+    if (!next_element22_head(p, last, h)) return false;
+    element_out[i] = {h.tag, h.type, h.physical, h.elementary};
+    offset[i + 1] = static_cast<std::size_t>(h.type->num_nodes);
+    if (h.partitions) partitions.store(true, std::memory_order_relaxed);
+    return true;
+  }).has_value();
+  if (!heads) return restore();
+  offset[0] = nodes_before;
+  for (std::uint64_t i = 0; i < count; ++i) offset[i + 1] += offset[i];
+  state.nodes22.resize(offset[count]);
+  NodeIndex* nodes = state.nodes22.data();
+  const TagIndex& index = state.node_index;
+  // The first line is the one after the cursor's (parse_lines checks the rest is blank).
+  const auto first_line = static_cast<std::size_t>(in.line()) + 1;
+  const bool ok = parse_lines(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    Element22Head h;
+    if (!next_element22_head(p, last, h)) return false;
+    for (std::size_t k = offset[i]; k < offset[i + 1]; ++k) {
+      std::uint64_t node_tag = 0;
+      if (!next_positive_int(p, last, node_tag)) return false;
+      nodes[k] = index.find(node_tag);
+      if (nodes[k] == TagIndex::kMissing) return false;
+    }
+    return record_ends(p, last);
+  });
+  if (!ok) return restore();
+  state.nodes22_offset.resize(before + count);
+  for (std::uint64_t i = 0; i < count; ++i) {
+    state.nodes22_offset[before + i] = offset[i];
+    state.positions22[before + i] = first_line + i;
+  }
+  if (partitions.load() && !state.warned_partitions) {
+    state.warned_partitions = true;
+    state.warn("MSH 2.2 partition tags are not used and were dropped");
+  }
+  return true;
 }
 
 }  // namespace quadval::io

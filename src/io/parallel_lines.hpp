@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "io/msh_reader.hpp"
 #include "io/tag_index.hpp"
 #include "io/text_cursor.hpp"
 #include "quadval/mesh.hpp"
@@ -38,5 +39,14 @@ bool read_tag_lines(TextCursor& in, std::uint64_t count, std::vector<Tag>& tags)
 /// The same for `count` lines of three finite coordinates each (TextCursor::real's
 /// numbers), appended to `coords`.
 bool read_coordinate_lines(TextCursor& in, std::uint64_t count, std::vector<double>& coords);
+
+/// MSH 2.2: the same for `count` lines of a positive node tag and three coordinates each,
+/// appended to `tags` and `coords` (repeated tags are the caller's to find).
+bool read_node22_lines(TextCursor& in, std::uint64_t count, std::vector<Tag>& tags, std::vector<double>& coords);
+
+/// MSH 2.2: the same for `count` element lines ("tag type number-of-tags tags... nodes...",
+/// every node in state.node_index), appended to state's elements22, nodes22,
+/// nodes22_offset and positions22 (their lines); warns, once, of partition tags.
+bool read_element22_lines(TextCursor& in, std::uint64_t count, MshReadState& state);
 
 }  // namespace quadval::io
