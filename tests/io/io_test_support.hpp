@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "quadval/error.hpp"
+#include "quadval/io.hpp"
 #include "quadval/mesh.hpp"
 
 namespace quadval::testing_io {
@@ -44,6 +46,23 @@ inline std::string file_bytes(const std::filesystem::path& p) {
 inline void write_bytes(const std::filesystem::path& p, const std::string& bytes) {
   std::ofstream out(p, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+/// Writes `text` to `path`, then reads it as a mesh.
+inline Mesh read_mesh_text(const std::filesystem::path& path, const std::string& text,
+                           std::vector<std::string>* warnings = nullptr) {
+  write_bytes(path, text);
+  return read_mesh(path, warnings);
+}
+
+/// The message of the InputError that reading `text` (written to `path`) raises; "" if none.
+inline std::string read_mesh_error(const std::filesystem::path& path, const std::string& text) {
+  try {
+    read_mesh_text(path, text);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 /// Doubles that printing must not round: fractions, huge and tiny magnitudes, subnormals.

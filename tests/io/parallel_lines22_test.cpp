@@ -85,17 +85,11 @@ BigMesh22 big_mesh22(int side, std::uint64_t seed) {
 }
 
 Mesh read_text(const ScratchDir& dir, const std::string& text, std::vector<std::string>* warnings = nullptr) {
-  testing_io::write_bytes(dir / "big22.msh", text);
-  return read_mesh(dir / "big22.msh", warnings);
+  return testing_io::read_mesh_text(dir / "big22.msh", text, warnings);
 }
 
 std::string read_error(const ScratchDir& dir, const std::string& text) {
-  try {
-    read_text(dir, text);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing_io::read_mesh_error(dir / "big22.msh", text);
 }
 
 constexpr int kSide = 200;  // 40,000 nodes, 39,601 quadrangles and 199 lines

@@ -92,17 +92,11 @@ BigMesh big_mesh(int side, std::uint64_t seed) {
 }
 
 Mesh read_text(const ScratchDir& dir, const std::string& text) {
-  testing_io::write_bytes(dir / "big.msh", text);
-  return read_mesh(dir / "big.msh");
+  return testing_io::read_mesh_text(dir / "big.msh", text);
 }
 
 std::string read_error(const ScratchDir& dir, const std::string& text) {
-  try {
-    read_text(dir, text);
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
+  return testing_io::read_mesh_error(dir / "big.msh", text);
 }
 
 // 200 x 200 nodes, 199 x 199 quadrangles: every block above kParallelLines.
