@@ -1,7 +1,8 @@
 #pragma once
-// The element and coordinate lines of a large ASCII MSH 4.1 block, parsed on OpenMP's
-// threads: they are nearly all of a large mesh's reading (1M hexahedra, 128 MB: 0.40 s on
-// one thread, of which the element lines two thirds).
+// The element and coordinate lines of a large ASCII MSH 4.1 block, and of a large MSH 2.2
+// $Nodes or $Elements section, parsed on OpenMP's threads: they are nearly all of a large
+// mesh's reading (1M hexahedra, 128 MB: 0.40 s on one thread, of which the element lines
+// two thirds).
 //
 // Only the plain form that Gmsh writes takes this path: one record per line, every line a
 // record, single values separated by blanks. At anything else (a blank line, a bad or
