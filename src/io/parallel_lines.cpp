@@ -238,11 +238,12 @@ bool read_node22_lines(TextCursor& in, std::uint64_t count, std::vector<Tag>& ta
 bool read_element22_lines(TextCursor& in, std::uint64_t count, MshReadState& state) {
   if (count < kParallelLines) return false;
   // Two passes, as the node count of a line shows only from its type: the heads and node
-  // counts, then (at offsets summed in between) the nodes.
+  // counts, then (at offsets summed in between, from where each head ended) the nodes.
   const std::size_t before = state.elements22.size(), nodes_before = state.nodes22.size();
   state.elements22.resize(before + count);
   state.positions22.resize(before + count);
   std::vector<std::size_t> offset(count + 1, 0);
+  std::vector<std::size_t> head_bytes(count);
   Msh22Element* element_out = state.elements22.data() + before;
   std::atomic<bool> partitions{false};
   const auto restore = [&] {
@@ -252,8 +253,10 @@ bool read_element22_lines(TextCursor& in, std::uint64_t count, MshReadState& sta
     return false;
   };
   const bool heads = parse_lines_here(in, count, [&](const char* p, const char* last, std::uint64_t i) {
+    const char* first = p;
     Element22Head h;
     if (!next_element22_head(p, last, h)) return false;
+    head_bytes[i] = static_cast<std::size_t>(p - first);
     element_out[i] = {h.tag, h.type, h.physical, h.elementary};
     offset[i + 1] = static_cast<std::size_t>(h.type->num_nodes);
     if (h.partitions) partitions.store(true, std::memory_order_relaxed);
@@ -268,8 +271,7 @@ bool read_element22_lines(TextCursor& in, std::uint64_t count, MshReadState& sta
   // The first line is the one after the cursor's (parse_lines checks the rest is blank).
   const auto first_line = static_cast<std::size_t>(in.line()) + 1;
   const bool ok = parse_lines(in, count, [&](const char* p, const char* last, std::uint64_t i) {
-    Element22Head h;
-    if (!next_element22_head(p, last, h)) return false;
+    p += head_bytes[i];
     for (std::size_t k = offset[i]; k < offset[i + 1]; ++k) {
       std::uint64_t node_tag = 0;
       if (!next_positive_int(p, last, node_tag)) return false;
