@@ -227,7 +227,8 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
   cmd->add_option("input", o->input, "Triangle mesh (.msh, .stl, .obj, .off)")->required();
   cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu); element field 'eta'")
       ->required();
-  cmd->add_option("--algo", o->algo, "blossom (optimal, all-quad) or greedy (quad-dominant)")
+  cmd->add_option("--algo", o->algo, "blossom (optimal, all-quad), lookahead (look-ahead tree, see --horizon: linear time, "
+                  "near-optimal, quad-dominant) or greedy (quad-dominant)")
       ->check(CLI::IsMember({"blossom", "greedy", "lookahead"}))
       ->capture_default_str();
   cmd->add_option("--cost", o->cost, "Pair cost: angle (1 - eta, eq. 3) or crossfield (eq. 7)")
