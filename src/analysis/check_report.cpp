@@ -73,10 +73,13 @@ void quality_section(std::string& out, const CheckSummary& r, bool sj, std::size
   out += "\n";
 }
 
-// One element of the JSON "elements" array, in the layout of nlohmann::json::dump(1) nested
-// two levels deep (keys sorted), written straight into `out`: the DOM and its dump took 5 s
-// for a million elements. Non-finite doubles are null, as nlohmann writes them; the others
-// the shortest text that reads back to the same double.
+// One element of the JSON "elements" array on one line, as nlohmann::json::dump() writes it
+// (keys sorted, no spaces), straight into `out`: the DOM and its dump took 5 s for a million
+// elements. One line per element instead of dump(1)'s layout (a line per value) makes the
+// file a quarter smaller and lets line tools pick elements: 1M hexahedra, --measure
+// jacobian 378 -> 278 MB, CLI 2.08-2.90 -> 2.01-2.19 s (three alternating runs); --measure
+// all 670 -> 504 MB. Non-finite doubles are null, as nlohmann writes them; the others the
+// shortest text that reads back to the same double.
 void append_element_json(std::string& out, const ElementCheck& e, const DistortionBounds& d,
                          const QualityBounds& mu, const QualityBounds& sj) {
   auto it = std::back_inserter(out);
@@ -87,40 +90,40 @@ void append_element_json(std::string& out, const ElementCheck& e, const Distorti
       out += "null";
   };
   const auto pair = [&](const char* key, double lo, double hi) {
-    fmt::format_to(it, FMT_COMPILE("   \"{}\": [\n    "), key);
+    fmt::format_to(it, FMT_COMPILE("\"{}\":["), key);
     number(lo);
-    out += ",\n    ";
+    out += ',';
     number(hi);
-    out += "\n   ],\n";
+    out += "],";
   };
   const auto field = [&](const char* key, double x) {
-    fmt::format_to(it, FMT_COMPILE("   \"{}\": "), key);
+    fmt::format_to(it, FMT_COMPILE("\"{}\":"), key);
     number(x);
-    out += ",\n";
+    out += ',';
   };
   const auto quality = [&](const char* key, const QualityBounds& q) {
     if (std::isnan(q.lower)) return;
-    fmt::format_to(it, FMT_COMPILE("   \"{}\": {{\n    \"lower\": "), key);
+    fmt::format_to(it, FMT_COMPILE("\"{}\":{{\"lower\":"), key);
     number(q.lower);
-    fmt::format_to(it, FMT_COMPILE(",\n    \"subdivisions\": {},\n    \"tolerance_met\": {},\n    \"upper\": "), q.subdivisions,
+    fmt::format_to(it, FMT_COMPILE(",\"subdivisions\":{},\"tolerance_met\":{},\"upper\":"), q.subdivisions,
                    q.tolerance_met);
     number(q.upper);
-    out += "\n   },\n";
+    out += "},";
   };
-  out += "{\n";
+  out += '{';
   if (e.analysed) {
     const JacobianBounds& b = e.bounds;
     pair("distortion", d.lower, d.upper);
-    fmt::format_to(it, FMT_COMPILE("   \"exact\": {},\n"), b.exact);
+    fmt::format_to(it, FMT_COMPILE("\"exact\":{},"), b.exact);
     pair("jmax", b.jmax_lower, b.jmax_upper);
     pair("jmin", b.jmin_lower, b.jmin_upper);
     field("jmin_over_javg", e.jmin_over_javg());
     quality("mu", mu);
     field("ratio_lower", e.ratio_lower());
     quality("sj", sj);
-    fmt::format_to(it, FMT_COMPILE("   \"stage\": {},\n   \"subdivisions\": {},\n"), b.stage, b.subdivisions);
+    fmt::format_to(it, FMT_COMPILE("\"stage\":{},\"subdivisions\":{},"), b.stage, b.subdivisions);
   }
-  fmt::format_to(it, FMT_COMPILE("   \"tag\": {},\n   \"type\": {},\n   \"validity\": \"{}\"\n  }}"), e.tag, e.type->gmsh_id,
+  fmt::format_to(it, FMT_COMPILE("\"tag\":{},\"type\":{},\"validity\":\"{}\"}}"), e.tag, e.type->gmsh_id,
                  answer(e));
 }
 
@@ -314,8 +317,8 @@ std::string check_json(const CheckReport& r) {
   return out.str();
 }
 
-// The layout of json::dump(1) for {"elements": [...], "summary": {...}} (keys sorted), one
-// element at a time: each element is dumped alone and indented two levels deeper.
+// {"elements": [...], "summary": {...}} (keys sorted), one element at a time, each on a line
+// of its own (append_element_json); the summary as json::dump(1) lays it out.
 CheckJsonWriter::CheckJsonWriter(std::ostream& out) : out_(&out) { *out_ << "{\n \"elements\": ["; }
 
 void CheckJsonWriter::add(const CheckBatch& b) {
