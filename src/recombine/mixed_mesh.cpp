@@ -4,21 +4,18 @@
 #include <cmath>
 
 #include "quadval/error.hpp"
-#include "quadval/quad_quality.hpp"
+#include "smoothing.hpp"
 
 namespace quadval::recombine_detail {
 
 double element_score(const MixedMesh& m, const std::array<NodeIndex, 4>& element,
                      const std::array<double, 3>& normal) noexcept {
-  if (element[3] != kNoNode) {
-    const QuadCorners x{m.point(element[0]), m.point(element[1]), m.point(element[2]),
-                        m.point(element[3])};
-    const QuadEta q = quad_eta(x, normal);
-    if (q.shape == QuadShape::ok && q.eta > 0.0) return q.eta;
-    return std::min(quad_min_corner_sine(x, normal), 0.0);
-  }
-  double worst = 1.0;
   const double nn = std::sqrt(normal[0] * normal[0] + normal[1] * normal[1] + normal[2] * normal[2]);
+  // A quad: quad_eta's eta where it is positive, else min(quad_min_corner_sine, 0), by
+  // smoothing_score, which gives those values to the bit with 4 square roots instead of up to
+  // 17 (1M triangles, the serial polish and swap stages: see smoothing.hpp).
+  if (element[3] != kNoNode) return smoothing_score(m.coords, element, normal, nn);
+  double worst = 1.0;
   for (int k = 0; k < 3; ++k) {
     const auto a = m.point(element[k]), b = m.point(element[(k + 1) % 3]),
                c = m.point(element[(k + 2) % 3]);

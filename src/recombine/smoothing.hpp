@@ -11,14 +11,24 @@
 
 namespace quadval::recombine_detail {
 
-/// element_score of a quad (eta of eq. 3 when convex, else the smallest signed corner sine,
-/// <= 0), equal to it bit for bit (the same operations in the same order), but with each edge
-/// and its length computed once: 4 square roots instead of 9. Returns -2 for a triangle.
+/// The score of a quad (element_score's, which calls it): eta of eq. 3 (quad_eta) when that is
+/// positive, else min(quad_min_corner_sine, 0), equal to those bit for bit (their operations in
+/// their order), but with each edge and its length computed once: 4 square roots instead of
+/// up to 17. Returns -2 for a triangle.
 /// @param element        4 corners, counter-clockwise seen from `normal`
 /// @param coords         MixedMesh::coords (#nodes × 3)
 /// @param normal_length  std::sqrt(n·n) of `normal`, summed in x, y, z order
 double smoothing_score(const std::vector<double>& coords, const std::array<NodeIndex, 4>& element,
                        const std::array<double, 3>& normal, double normal_length) noexcept;
+
+/// smoothing_score of up to four quads at once (lane k: quads[k], normals[k],
+/// normal_lengths[k], for k < count), each equal to it bit for bit: the per-corner products
+/// and square roots in SIMD lanes with the same operations in the same order (no FMA
+/// contraction: -ffp-contract=off), the rest per quad.
+/// @pre 1 <= count <= 4; every quads[k] is a quad (no kNoNode)
+void smoothing_scores4(const std::vector<double>& coords, const std::array<NodeIndex, 4>* const quads[4],
+                       const std::array<double, 3>* const normals[4], const double normal_lengths[4], int count,
+                       double out[4]) noexcept;
 
 struct SmoothingOptions {
   int passes = 5;
@@ -47,10 +57,11 @@ struct SmoothingOptions {
 ///    or above the worst score of the mesh at the start of the sweep (so eta_min never drops
 ///    and eta_mean rises; measured on rect-sin-a6: mean 0.740 -> 0.763, min kept).
 /// No move can invalidate a valid element.
-/// Cost: quads scored by smoothing_score, element data copied in node order, and a trial
-/// stops at the first score that already refuses it; the result is the same, to the bit, as
-/// the plain sweep in smoothing_order (tests/recombine/smoothing_test.cpp checks it against
-/// one). Two threads: square-hole-1M, the two smoothing stages 3.6 + 2.4 s -> 1.6 + 1.9 s.
+/// Cost: quads scored four at a time (smoothing_scores4) and element data copied in node
+/// order; the result is the same, to the bit, as the plain sweep in smoothing_order
+/// (tests/recombine/smoothing_test.cpp checks it against one). Two threads: square-hole-1M,
+/// the two smoothing stages 3.6 + 2.4 s -> 1.6 + 1.9 s; four at a time (look-ahead's quads,
+/// two alternating runs): 2.42-2.44 -> 2.08-2.24 s for both.
 std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options);
 
 /// The order in which smooth() moves the nodes: the movable nodes in node order are cut into

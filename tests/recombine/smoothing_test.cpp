@@ -1,5 +1,6 @@
-// Smoothing (Paper I §6). smoothing_score equals element_score bit for bit (closed forms and
-// random quads, valid, reflex, inverted, degenerate). smooth() gives, bit for bit, what the
+// Smoothing (Paper I §6). smoothing_score, one quad or four at once, equals the score's
+// definition from quad_eta and quad_min_corner_sine bit for bit (closed forms and random
+// quads, valid, reflex, inverted, degenerate). smooth() gives, bit for bit, what the
 // plain sweep of its doc comment gives in smoothing_order (written out here with
 // element_score, node_elements and corner_of: none of smooth()'s shortcuts), on one thread
 // or two; smoothing_order visits every movable node once and no two blocks of one colour
@@ -13,6 +14,7 @@
 #include <gtest/gtest.h>
 #include <omp.h>
 
+#include "quadval/quad_quality.hpp"
 #include "recombine/boundary_slide.hpp"
 #include "recombine/smoothing.hpp"
 
@@ -49,31 +51,73 @@ TEST(SmoothingScore, ClosedForms) {
   EXPECT_EQ(smoothing_score(t.coords, {0, 1, 2, kNoNode}, up, 1.0), -2.0);
 }
 
+// The score by its definition: quad_eta's eta where positive, else the least corner sine
+// (at most 0), from the public quality functions (none of smoothing_score's shortcuts).
+double defined_score(const MixedMesh& m, const std::array<NodeIndex, 4>& q, const std::array<double, 3>& n) {
+  const QuadCorners x{m.point(q[0]), m.point(q[1]), m.point(q[2]), m.point(q[3])};
+  const QuadEta e = quad_eta(x, n);
+  if (e.shape == QuadShape::ok && e.eta > 0.0) return e.eta;
+  return std::min(quad_min_corner_sine(x, n), 0.0);
+}
+
 // Random quads around the unit square, from slightly to wildly perturbed (so convex, reflex,
-// inverted and nearly degenerate ones), with tilted and scaled normals.
-TEST(SmoothingScore, EqualsElementScoreBitForBit) {
+// inverted and nearly degenerate ones), with tilted, scaled and (every 101st) zero normals,
+// all in one mesh: quad i has nodes 4i .. 4i + 3.
+MixedMesh random_quads(int count) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  int valid = 0, invalid = 0;
-  for (int i = 0; i < 20000; ++i) {
+  MixedMesh m;
+  for (int i = 0; i < count; ++i) {
     const double amplitude = 0.02 + 0.8 * (i % 10) / 9.0;
-    MixedMesh m;
     const double corner[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    const auto first = static_cast<NodeIndex>(m.num_nodes());
     for (int k = 0; k < 4; ++k)
       m.add_node({corner[k][0] + amplitude * unit(rng), corner[k][1] + amplitude * unit(rng),
                   amplitude * unit(rng) * (i % 3 == 0)},
-                 k + 1);
-    if (i % 97 == 0) std::memcpy(&m.coords[3], &m.coords[0], 3 * sizeof(double));  // repeat
-    const std::array<double, 3> n{0.3 * unit(rng) * (i % 2), 0.3 * unit(rng) * (i % 2),
-                                  (1.0 + 0.5 * unit(rng)) * (i % 5 == 4 ? -1.0 : 1.0)};
-    m.elements.push_back({0, 1, 2, 3});
+                 first + k + 1);
+    if (i % 97 == 0) std::memcpy(&m.coords[3 * (first + 1)], &m.coords[3 * first], 3 * sizeof(double));  // repeat
+    std::array<double, 3> n{0.3 * unit(rng) * (i % 2), 0.3 * unit(rng) * (i % 2),
+                            (1.0 + 0.5 * unit(rng)) * (i % 5 == 4 ? -1.0 : 1.0)};
+    if (i % 101 == 0) n = {0, 0, 0};
+    m.elements.push_back({first, first + 1, first + 2, first + 3});
     m.normal.push_back(n);
-    const double want = element_score(m, 0);
-    EXPECT_EQ(smoothing_score(m.coords, m.elements[0], n, normal_length(n)), want) << "quad " << i;
+  }
+  return m;
+}
+
+TEST(SmoothingScore, EqualsDefinitionBitForBit) {
+  const MixedMesh m = random_quads(20000);
+  int valid = 0, invalid = 0;
+  for (std::size_t i = 0; i < m.elements.size(); ++i) {
+    const double want = defined_score(m, m.elements[i], m.normal[i]);
+    EXPECT_EQ(smoothing_score(m.coords, m.elements[i], m.normal[i], normal_length(m.normal[i])), want) << "quad " << i;
+    EXPECT_EQ(element_score(m, i), want) << "quad " << i;
     (want > 0 ? valid : invalid)++;
   }
   EXPECT_GT(valid, 5000);
   EXPECT_GT(invalid, 2000);
+}
+
+// Four lanes (or fewer, the others unused) give each quad's smoothing_score to the bit.
+TEST(SmoothingScore, FourLanesEqualOneByOne) {
+  const MixedMesh m = random_quads(20000);
+  std::size_t i = 0;
+  for (int group = 0; i < m.elements.size(); ++group) {
+    const int count = static_cast<int>(std::min<std::size_t>(1 + group % 4, m.elements.size() - i));
+    const std::array<NodeIndex, 4>* quads[4] = {};
+    const std::array<double, 3>* normals[4] = {};
+    double lengths[4] = {}, out[4] = {9, 9, 9, 9};
+    for (int k = 0; k < count; ++k) {
+      quads[k] = &m.elements[i + k];
+      normals[k] = &m.normal[i + k];
+      lengths[k] = normal_length(m.normal[i + k]);
+    }
+    smoothing_scores4(m.coords, quads, normals, lengths, count, out);
+    for (int k = 0; k < count; ++k)
+      EXPECT_EQ(out[k], smoothing_score(m.coords, m.elements[i + k], m.normal[i + k], lengths[k])) << "quad " << i + k;
+    for (int k = count; k < 4; ++k) EXPECT_EQ(out[k], 9.0) << "unused lane " << k << " written";
+    i += static_cast<std::size_t>(count);
+  }
 }
 
 // The sweep of smooth()'s doc comment, written the plain way: every node in smoothing_order,
