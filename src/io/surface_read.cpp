@@ -10,8 +10,10 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 
 #include <fmt/core.h>
+#include <omp.h>
 
 #include "io/byte_cursor.hpp"
 #include "io/text_cursor.hpp"
@@ -27,6 +29,8 @@ class SurfaceBuilder {
   void add_node(double x, double y, double z) {
     coords_.insert(coords_.end(), {x, y, z});
   }
+  /// Adds nodes from x, y, z triples.
+  void add_nodes(std::span<const double> xyz) { coords_.insert(coords_.end(), xyz.begin(), xyz.end()); }
   std::size_t num_nodes() const noexcept { return coords_.size() / 3; }
   const double* node(NodeIndex n) const noexcept { return coords_.data() + 3 * std::size_t{n}; }
   /// Adds a face of 3 or 4 node indices (checked by the caller).
@@ -285,51 +289,149 @@ Mesh read_stl(std::string_view bytes, const std::string& file, std::vector<std::
                                               "the file has {} bytes)", bytes.size()));
 }
 
-Mesh read_obj(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings) {
-  LineFields in(bytes, file, '#');
-  SurfaceBuilder builder;
-  struct Face { std::array<std::int64_t, 4> v; int n; long line; };
+namespace {
+
+// The statements of a run of whole lines of an OBJ file (all of it, or one thread's part),
+// line numbers counted from the run's first line.
+struct ObjRun {
+  struct Face {
+    std::array<std::int64_t, 4> v;  // 1-based; negative: relative, to the run's vertices so far
+    int n;
+    long line;
+    std::uint32_t before;  // the run's vertices before this face
+  };
+  std::vector<double> coords;
   std::vector<Face> faces;
-  std::vector<std::string> unknown;
+  std::vector<std::pair<std::string, long>> unknown;  // first use of each unknown statement
+};
+
+// Reads the statements of `in` into `run` (InputError at a bad line). Negative indices are
+// resolved at once when `absolute` (the run starts the file), else kept for the caller.
+void read_obj_statements(LineFields& in, bool absolute, ObjRun& run) {
   while (in.next()) {
     const std::string_view key = in[0];
     if (key == "v") {
       if (in.size() < 4) in.fail("expected 'v x y z'");
-      builder.add_node(in.real(1, "vertex x coordinate"), in.real(2, "vertex y coordinate"), in.real(3, "vertex z coordinate"));
+      run.coords.insert(run.coords.end(), {in.real(1, "vertex x coordinate"), in.real(2, "vertex y coordinate"),
+                                           in.real(3, "vertex z coordinate")});
     } else if (key == "f") {
       check_face_size(in, in.size() - 1);
-      Face f{{0, 0, 0, 0}, static_cast<int>(in.size() - 1), in.line()};
+      const auto before = static_cast<std::uint32_t>(run.coords.size() / 3);
+      ObjRun::Face f{{0, 0, 0, 0}, static_cast<int>(in.size() - 1), in.line(), before};
       for (int k = 0; k < f.n; ++k) {
         std::int64_t i = in.integer(1 + static_cast<std::size_t>(k), "vertex index", true);
         if (i == 0) in.fail("vertex index 0, expected 1-based or negative indices");
-        if (i < 0) {  // relative to the vertices read so far
-          i += static_cast<std::int64_t>(builder.num_nodes()) + 1;
+        if (i < 0 && absolute) {  // relative to the vertices read so far
+          i += static_cast<std::int64_t>(before) + 1;
           if (i < 1) in.fail(fmt::format("relative vertex index {} points before the first vertex", in[1 + static_cast<std::size_t>(k)]));
         }
         f.v[static_cast<std::size_t>(k)] = i;
       }
-      faces.push_back(f);
+      run.faces.push_back(f);
     } else if (key == "vt" || key == "vn" || key == "vp" || key == "g" || key == "o" || key == "s" ||
                key == "usemtl" || key == "mtllib") {
       // Texture, normals, groups and materials say nothing about the geometry we keep.
-    } else if (std::find(unknown.begin(), unknown.end(), key) == unknown.end()) {
-      unknown.emplace_back(key);
-      warnings.push_back(fmt::format("{}:{}: OBJ statement '{}' is not used and was skipped", file, in.line(),
+    } else if (std::none_of(run.unknown.begin(), run.unknown.end(), [&](const auto& u) { return u.first == key; })) {
+      run.unknown.emplace_back(key, in.line());
+    }
+  }
+}
+
+// Files from this size on are read in runs of lines on several threads (1M triangles,
+// 55 MB: see read_obj).
+constexpr std::size_t kParallelObjBytes = std::size_t{1} << 20;
+
+// The file cut into `runs` runs of whole lines, each read on a thread of its own; nullopt
+// where a run has an error, or a relative index points before the file's first vertex: the
+// whole file is then read as one run, which reports the first error in the file.
+std::optional<std::vector<ObjRun>> read_obj_runs(std::string_view bytes, const std::string& file, std::size_t runs) {
+  std::vector<std::size_t> cut(runs + 1, bytes.size());
+  cut[0] = 0;
+  for (std::size_t k = 1; k < runs; ++k) {
+    const std::size_t line_end = bytes.find('\n', std::max(cut[k - 1], bytes.size() / runs * k));
+    cut[k] = line_end == std::string_view::npos ? bytes.size() : line_end + 1;
+  }
+  std::vector<ObjRun> out(runs);
+  std::vector<char> failed(runs, 0);
+#pragma omp parallel for num_threads(static_cast<int>(runs)) schedule(static, 1)
+  for (std::size_t k = 0; k < runs; ++k) {
+    try {
+      LineFields in(bytes.substr(cut[k], cut[k + 1] - cut[k]), file, '#');
+      read_obj_statements(in, k == 0, out[k]);
+    } catch (...) {
+      failed[k] = 1;
+    }
+  }
+  if (std::find(failed.begin(), failed.end(), 1) != failed.end()) return std::nullopt;
+  // Runs after the first: their lines and vertices start after the earlier ones'.
+  long line0 = 0;
+  std::int64_t vertex0 = 0;
+  for (std::size_t k = 0; k < runs; ++k) {
+    ObjRun& run = out[k];
+    for (ObjRun::Face& f : run.faces) {
+      f.line += line0;
+      for (int j = 0; j < f.n; ++j) {
+        std::int64_t& i = f.v[static_cast<std::size_t>(j)];
+        if (i < 0 && (i += vertex0 + f.before + 1) < 1) return std::nullopt;
+      }
+    }
+    for (auto& u : run.unknown) u.second += line0;
+    line0 += static_cast<long>(std::count(bytes.begin() + static_cast<std::ptrdiff_t>(cut[k]),
+                                          bytes.begin() + static_cast<std::ptrdiff_t>(cut[k + 1]), '\n'));
+    vertex0 += static_cast<std::int64_t>(run.coords.size() / 3);
+  }
+  return out;
+}
+
+}  // namespace
+
+Mesh read_obj(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings, std::size_t runs,
+              std::size_t* runs_used) {
+  std::vector<ObjRun> parts;
+  if (runs > 1) {
+    if (auto r = read_obj_runs(bytes, file, runs)) parts = std::move(*r);
+  }
+  if (runs_used) *runs_used = std::max<std::size_t>(1, parts.size());
+  if (parts.empty()) {
+    parts.resize(1);
+    LineFields in(bytes, file, '#');
+    read_obj_statements(in, true, parts[0]);
+  }
+  SurfaceBuilder builder;
+  std::size_t n = 0, faces = 0;
+  for (const ObjRun& run : parts) {
+    n += run.coords.size() / 3;
+    faces += run.faces.size();
+  }
+  builder.reserve(n, faces);
+  std::vector<std::string_view> warned;
+  for (const ObjRun& run : parts) {
+    builder.add_nodes(run.coords);
+    for (const auto& [key, line] : run.unknown) {
+      if (std::find(warned.begin(), warned.end(), key) != warned.end()) continue;
+      warned.emplace_back(key);
+      warnings.push_back(fmt::format("{}:{}: OBJ statement '{}' is not used and was skipped", file, line,
                                      TextCursor::shorten(key)));
     }
   }
-  const auto n = static_cast<std::int64_t>(builder.num_nodes());
-  for (const Face& f : faces) {
-    std::array<NodeIndex, 4> nodes{};
-    for (int k = 0; k < f.n; ++k) {
-      if (f.v[static_cast<std::size_t>(k)] > n)
-        throw InputError::at_line(file, f.line, fmt::format("face refers to vertex {}, the file has {}", f.v[static_cast<std::size_t>(k)], n));
-      nodes[static_cast<std::size_t>(k)] = static_cast<NodeIndex>(f.v[static_cast<std::size_t>(k)] - 1);
+  for (const ObjRun& run : parts)
+    for (const ObjRun::Face& f : run.faces) {
+      std::array<NodeIndex, 4> nodes{};
+      for (int k = 0; k < f.n; ++k) {
+        if (f.v[static_cast<std::size_t>(k)] > static_cast<std::int64_t>(n))
+          throw InputError::at_line(file, f.line, fmt::format("face refers to vertex {}, the file has {}", f.v[static_cast<std::size_t>(k)], n));
+        nodes[static_cast<std::size_t>(k)] = static_cast<NodeIndex>(f.v[static_cast<std::size_t>(k)] - 1);
+      }
+      builder.add_face(std::span<const NodeIndex>(nodes.data(), static_cast<std::size_t>(f.n)));
     }
-    builder.add_face(std::span<const NodeIndex>(nodes.data(), static_cast<std::size_t>(f.n)));
-  }
-  if (n == 0 && faces.empty()) throw InputError::in_file(file, "no vertices and no faces, expected an OBJ surface");
+  if (n == 0 && faces == 0) throw InputError::in_file(file, "no vertices and no faces, expected an OBJ surface");
   return builder.finish();
+}
+
+Mesh read_obj(std::string_view bytes, const std::string& file, std::vector<std::string>& warnings) {
+  const auto threads = static_cast<std::size_t>(std::max(1, omp_get_max_threads()));
+  const std::size_t runs = bytes.size() < kParallelObjBytes ? 1 : std::min(threads, bytes.size() / (kParallelObjBytes / 2));
+  return read_obj(bytes, file, warnings, runs);
 }
 
 Mesh read_off(std::string_view bytes, const std::string& file, std::vector<std::string>& /*warnings*/) {

@@ -4,6 +4,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   io/msh_gmsh_test.cpp
   io/msh_read_test.cpp
   io/msh_round_trip_test.cpp
+  io/obj_runs_test.cpp
   io/out_buffer_test.cpp
   io/parallel_lines_test.cpp
   io/parallel_lines22_test.cpp
