@@ -242,7 +242,7 @@ class Smoother {
   // The scores of the star entries [first, last) into trial[0 ..): quads four at a time
   // (smoothing_scores4: the same values; random quads 59-73 -> 43-48 ns each, the asin per
   // quad left), triangles by element_score. The move's test then reads them in star order.
-  void score_star(std::uint32_t first, std::uint32_t last, std::vector<double>& trial) const noexcept {
+  void score_star(std::uint32_t first, std::uint32_t last, std::vector<double>& trial) const {
     trial.resize(last - first);
     const std::array<NodeIndex, 4>* quads[4];
     const std::array<double, 3>* normals[4];
