@@ -38,13 +38,13 @@
 #include "blossom_solver.hpp"
 
 #include <algorithm>
-#include <deque>
 #include <exception>
 #include <limits>
 #include <memory>
 #include <mutex>
-#include <queue>
 
+#include "event_queue.hpp"
+#include "huge_page_allocator.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval::recombine_detail {
@@ -53,42 +53,6 @@ namespace {
 
 constexpr std::int32_t kNone = -1;
 constexpr std::uint32_t kNoTree = 0xffffffffu;
-
-struct Event {
-  std::int64_t key;
-  std::uint32_t id;
-  std::uint64_t seq = 0;  // queue order, the tie-break
-  bool operator>(const Event& o) const { return key > o.key || (key == o.key && seq > o.seq); }
-};
-// A priority queue of events by (key, seq), with a FIFO lane for the events queued when
-// already due (key == the current "now"): on meshes most grow events are, since whole regions
-// of tight edges are absorbed at one dual value, and the lane spares them the heap (measured:
-// 2x less time on uniform meshes). Same order as one heap: an event in the heap with the lane's
-// key was queued before the dual value reached it, so before every event in the lane.
-class EventQueue {
- public:
-  void push(const Event& ev, std::int64_t now) {
-    if (ev.key == now)
-      due_.push_back(ev);
-    else
-      heap_.push(ev);
-  }
-  bool empty() const { return due_.empty() && heap_.empty(); }
-  const Event& top() const { return from_heap() ? heap_.top() : due_.front(); }
-  void pop() {
-    if (from_heap())
-      heap_.pop();
-    else
-      due_.pop_front();
-  }
-
- private:
-  bool from_heap() const {
-    return due_.empty() || (!heap_.empty() && heap_.top().key <= due_.front().key);
-  }
-  std::priority_queue<Event, std::vector<Event>, std::greater<Event>> heap_;
-  std::deque<Event> due_;
-};
 
 enum Label : std::int8_t { kFree = 0, kPlus = 1, kMinus = 2 };
 
@@ -391,9 +355,9 @@ class Solver {
       const std::uint32_t other = outer(other_end(e, v));
       if (other == b) continue;
       if (slot_[other].label == kPlus)
-        shrink_queue_.push({2 * eps_ + slack(e), e, seq_++}, 2 * eps_);
+        shrink_queue_.push(2 * eps_ + slack(e), e, 2 * eps_);
       else if (slot_[other].label == kFree)
-        grow_queue_.push({eps_ + slack(e), e, seq_++}, eps_);
+        grow_queue_.push(eps_ + slack(e), e, eps_);
       else if (slot_[other].tree != slot_[b].tree)
         parked_[slot_[other].tree].push_back(e);
     }
@@ -408,7 +372,7 @@ class Solver {
         const std::uint32_t e = incident_[i];
         const CostEdge& ce = edges_[e];
         if (slot_[outer(ce.u == v ? ce.v : ce.u)].label == kPlus)
-          grow_queue_.push({eps_ + slack(e), e, seq_++}, eps_);
+          grow_queue_.push(eps_ + slack(e), e, eps_);
       }
     });
   }
@@ -427,7 +391,7 @@ class Solver {
   // Labels b "-" (reached through endpoint p, whose vertex is in the parent), then its mate "+".
   void assign_minus(std::uint32_t b, std::int32_t p, std::uint32_t t) {
     enter_tree(b, kMinus, p, t);
-    if (is_blossom(b)) expand_queue_.push({eps_ + z_[b] / 2, b, seq_++}, eps_);
+    if (is_blossom(b)) expand_queue_.push(eps_ + z_[b] / 2, b, eps_);
     const std::int32_t q = slot_[slot_[b].base].mate;
     QV_ASSERT(q != kNone, "a '-' node without a mate");
     assign_plus(outer(vertex(q)), q ^ 1, t);
@@ -436,7 +400,7 @@ class Solver {
   // Drops stale entries from the top of each queue (their key no longer matches the state).
   void clean_grow() {
     while (!grow_queue_.empty()) {
-      const Event ev = grow_queue_.top();
+      const EventQueue::Event ev = grow_queue_.top();
       const CostEdge& ce = edges_[ev.id];
       const std::uint32_t a = outer(ce.u), b = outer(ce.v);
       const Label la = slot_[a].label, lb = slot_[b].label;
@@ -444,7 +408,7 @@ class Solver {
         const std::int64_t key = eps_ + slack(ev.id);
         if (key == ev.key) return;
         grow_queue_.pop();
-        grow_queue_.push({key, ev.id, seq_++}, eps_);
+        grow_queue_.push(key, ev.id, eps_);
         continue;
       }
       grow_queue_.pop();
@@ -453,7 +417,7 @@ class Solver {
   }
   void clean_shrink() {
     while (!shrink_queue_.empty()) {
-      const Event ev = shrink_queue_.top();
+      const EventQueue::Event ev = shrink_queue_.top();
       const CostEdge& ce = edges_[ev.id];
       const std::uint32_t a = outer(ce.u), b = outer(ce.v);
       if (a != b && slot_[a].label == kPlus && slot_[b].label == kPlus &&
@@ -463,7 +427,7 @@ class Solver {
       if (a == b) continue;
       const Label la = slot_[a].label, lb = slot_[b].label;
       if ((la == kPlus && lb == kFree) || (la == kFree && lb == kPlus))
-        grow_queue_.push({eps_ + slack(ev.id), ev.id, seq_++}, eps_);
+        grow_queue_.push(eps_ + slack(ev.id), ev.id, eps_);
       else
         park(a, b, ev.id);
     }
@@ -482,7 +446,7 @@ class Solver {
   }
   void clean_expand() {
     while (!expand_queue_.empty()) {
-      const Event ev = expand_queue_.top();
+      const EventQueue::Event ev = expand_queue_.top();
       const std::uint32_t b = ev.id;
       if (b < num_nodes_ && alive(b) && slot_[b].parent == kNone && slot_[b].label == kMinus &&
           eps_ + (z_[b] + 2 * lazy(b)) / 2 == ev.key)
@@ -567,7 +531,7 @@ class Solver {
         const std::uint32_t a = outer(edges_[e].u), b = outer(edges_[e].v);
         const Label la = slot_[a].label, lb = slot_[b].label;
         if ((la == kPlus && lb == kFree) || (la == kFree && lb == kPlus))
-          grow_queue_.push({eps_ + slack(e), e, seq_++}, eps_);
+          grow_queue_.push(eps_ + slack(e), e, eps_);
       }
       std::vector<std::uint32_t>().swap(parked_[t]);
     }
@@ -698,7 +662,7 @@ class Solver {
     const std::uint32_t base_child = children[0];
     enter_tree(base_child, kMinus, p, tree);
     if (is_blossom(base_child))
-      expand_queue_.push({eps_ + z_[base_child] / 2, base_child, seq_++}, eps_);
+      expand_queue_.push(eps_ + z_[base_child] / 2, base_child, eps_);
     for (std::uint32_t c : children)
       if (slot_[c].label == kFree) push_edges_to_plus(c);
     free_ids_.push_back(b);
@@ -783,10 +747,12 @@ class Solver {
   }
 
   std::uint32_t n_;
-  std::vector<CostEdge> edges_;  // costs doubled
+  // The arrays read at random, per vertex or node, on huge pages (huge_page_allocator.hpp):
+  // square-hole-1M, solver alone, medians of 8 alternating runs, 10.25 -> 9.74 s.
+  HugePageVector<CostEdge> edges_;  // costs doubled
   const MatchingProgress& progress_;
   std::uint32_t free_at_start_ = 0;
-  std::vector<std::uint32_t> offsets_, incident_;
+  HugePageVector<std::uint32_t> offsets_, incident_;
   // What growing a tree reads of an edge's far end, in one cache line (the solver waits on
   // memory; square-hole-1M's matching: 19.4 -> 15.1 s, medians of 5, against one array per
   // field). Record k holds vertex k's fields (k < n), group k's and node k's: the three
@@ -809,34 +775,35 @@ class Solver {
     std::int32_t parent = kNone;    // node: the blossom containing it, or kNone
     std::uint32_t base = 0;         // node: its base vertex
   };
-  std::vector<Slot> slot_;
+  HugePageVector<Slot> slot_;
   std::uint32_t num_groups_ = 0, num_nodes_ = 0;
   std::vector<std::uint32_t> free_groups_;
-  std::vector<std::uint32_t> group_of_, size_, big_child_;  // per node (top-level: its group)
+  HugePageVector<std::uint32_t> group_of_, size_, big_child_;  // per node (top-level: its group)
   // Per node: vertices 0..n-1, blossoms from n on.
-  std::vector<std::int64_t> z_;
+  HugePageVector<std::int64_t> z_;
   std::vector<std::vector<std::uint32_t>> childs_;  // blossoms: the odd cycle, base first
   std::vector<std::vector<std::int32_t>> endps_;    // edge i joins childs i and i + 1
   std::vector<std::vector<std::uint32_t>> trees_;   // per tree: the nodes it labelled
   std::vector<std::vector<std::uint32_t>> parked_;  // per tree: edges parked with it (see park)
   std::uint32_t alive_trees_ = 0;
-  std::vector<std::uint32_t> mark_, free_ids_, stack_, minus_vertices_;
-  std::vector<std::vector<std::uint32_t>> boundary_;  // per group (blossom groups only)
-  std::vector<std::uint32_t> listed_in_;              // per vertex: the group listing it
+  HugePageVector<std::uint32_t> mark_;
+  std::vector<std::uint32_t> free_ids_, stack_, minus_vertices_;
+  HugePageVector<std::vector<std::uint32_t>> boundary_;  // per group (blossom groups only)
+  HugePageVector<std::uint32_t> listed_in_;            // per vertex: the group listing it
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work_;
   std::uint32_t stamp_ = 0;
   std::int64_t eps_ = 0;
-  std::uint64_t seq_ = 0;
   EventQueue grow_queue_, shrink_queue_, expand_queue_;
 };
 
-// The graph renumbered breadth first (vertices in the order a BFS from the lowest unvisited
-// vertex reaches them; edges by their lower new endpoint), so that the vertices a tree grows
-// over, and their edges, sit close together in memory. The solver is bound by memory latency:
-// on square-hole-100k/300k (nearly the same events and the same matching) CPU time went
-// 0.77 -> 0.55 s and 3.43 -> 2.60 s (medians of 3). The greedy start, which visits vertices in
-// index order, also leaves fewer vertices free in this order (uniform-100k: 4,238 -> 1,312
-// free, 7.95 -> 4.15 s).
+// The graph renumbered by connected component (components in the order of their lowest
+// vertex; inside one, the vertices keep their order), edges bucketed by their lower new
+// endpoint: each component is then a range of vertices and a range of edges. The solver is
+// bound by memory latency, so the caller's order matters: recombine's triangles come in
+// Z-order (node_order.hpp), where the vertices a tree grows over sit close together in memory.
+// Measured against a breadth-first renumbering (which had gained 0.77 -> 0.55 s on
+// square-hole-100k over Gmsh's numbering): square-hole-1M 11.0-12.2 -> 9.8-10.7 s (three
+// alternating runs), square-hole-100k and uniform-100k the same within the noise.
 struct LocalGraph {
   std::vector<CostEdge> edges;           // renumbered
   std::vector<std::uint32_t> edge_from;  // original index of each renumbered edge
@@ -844,7 +811,7 @@ struct LocalGraph {
   // and, since edges are bucketed by their lower end, a contiguous range of edges too.
   std::vector<std::uint32_t> component_start;
 };
-LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges) {
+LocalGraph component_order(std::uint32_t n, std::span<const CostEdge> edges) {
   std::vector<std::uint32_t> offsets(std::size_t{n} + 1, 0), adjacent(2 * edges.size());
   for (const CostEdge& e : edges) {
     ++offsets[e.u + 1];
@@ -858,27 +825,33 @@ LocalGraph breadth_first_order(std::uint32_t n, std::span<const CostEdge> edges)
       adjacent[fill[e.v]++] = e.u;
     }
   }
+  // Components by breadth-first search from each lowest unvisited vertex, then counted.
   constexpr std::uint32_t kUnseen = 0xffffffffu;
-  std::vector<std::uint32_t> new_id(n, kUnseen), queue;
+  std::vector<std::uint32_t> component(n, kUnseen), queue, size;
   queue.reserve(n);
-  LocalGraph g;
   for (std::uint32_t s = 0; s < n; ++s) {
-    if (new_id[s] != kUnseen) continue;
-    g.component_start.push_back(static_cast<std::uint32_t>(queue.size()));
-    new_id[s] = static_cast<std::uint32_t>(queue.size());
+    if (component[s] != kUnseen) continue;
+    const auto c = static_cast<std::uint32_t>(size.size());
+    queue.clear();
     queue.push_back(s);
-    for (std::size_t head = queue.size() - 1; head < queue.size(); ++head)
+    component[s] = c;
+    for (std::size_t head = 0; head < queue.size(); ++head)
       for (std::uint32_t i = offsets[queue[head]]; i < offsets[queue[head] + 1]; ++i)
-        if (new_id[adjacent[i]] == kUnseen) {
-          new_id[adjacent[i]] = static_cast<std::uint32_t>(queue.size());
+        if (component[adjacent[i]] == kUnseen) {
+          component[adjacent[i]] = c;
           queue.push_back(adjacent[i]);
         }
+    size.push_back(static_cast<std::uint32_t>(queue.size()));
   }
+  LocalGraph g;
+  g.component_start.assign(size.size() + 1, 0);
+  for (std::size_t c = 0; c < size.size(); ++c) g.component_start[c + 1] = g.component_start[c] + size[c];
+  std::vector<std::uint32_t> new_id(n), next(g.component_start.begin(), g.component_start.end() - 1);
+  for (std::uint32_t v = 0; v < n; ++v) new_id[v] = next[component[v]]++;
   // Edges bucketed by their lower new endpoint (a counting sort, stable).
   std::fill(offsets.begin(), offsets.end(), 0);
   for (const CostEdge& e : edges) ++offsets[std::min(new_id[e.u], new_id[e.v]) + 1];
   for (std::uint32_t v = 0; v < n; ++v) offsets[v + 1] += offsets[v];
-  g.component_start.push_back(n);
   g.edges.resize(edges.size());
   g.edge_from.resize(edges.size());
   for (std::uint32_t i = 0; i < edges.size(); ++i) {
@@ -930,7 +903,7 @@ bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge
     QV_ASSERT(edges[e].u < num_nodes && edges[e].v < num_nodes && edges[e].u != edges[e].v,
               "edge " << e << " (" << edges[e].u << ", " << edges[e].v << ") in a graph of "
                       << num_nodes);
-  const LocalGraph local = breadth_first_order(num_nodes, edges);
+  const LocalGraph local = component_order(num_nodes, edges);
   // Chunks: runs of whole components, each solved by a solver of its own (on the threads
   // there are): a surface of several faces, as CAD models give, has one component per face.
   // Small components are grouped, so that a chunk has at least `least` vertices.

@@ -8,9 +8,11 @@
 //
 // Measured against LEMON's MaxWeightedPerfectMatching (kept as the test oracle, and for the
 // non-perfect fallback): equal optimum everywhere tested, and about as fast (graded square
-// with a hole, 100k triangles: 0.76 s vs 0.71 s; 300k: 3.8 s vs 4.3 s). The graph is solved in
-// breadth-first order (see min_cost_perfect_matching): CPU time, medians of 3, before -> after:
-// square-hole-100k 0.77 -> 0.55 s, square-hole-300k 3.43 -> 2.60 s, uniform-100k 7.95 -> 4.15 s.
+// with a hole, 100k triangles: 0.76 s vs 0.71 s; 300k: 3.8 s vs 4.3 s). The solver waits on
+// memory, so the vertex order matters: a breadth-first renumbering gained (CPU time, medians of
+// 3) square-hole-100k 0.77 -> 0.55 s, square-hole-300k 3.43 -> 2.60 s, uniform-100k 7.95 ->
+// 4.15 s over Gmsh's numbering; recombine's Z-order (node_order.hpp), now kept as given (see
+// component_order in the .cpp), does better still on square-hole-1M.
 //
 // Both solvers grow faster than linearly on large meshes, and the time goes to the last
 // augmentations. Measured (event counts per augmentation): on square-hole-100k the first 7,000

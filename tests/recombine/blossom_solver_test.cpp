@@ -273,7 +273,7 @@ Graph disjoint_union(std::mt19937& rng, const std::vector<int>& sizes, std::int6
 TEST(BlossomSolver, SolvesDisjointComponentsOnTheirOwnOnAnyThreads) {
   std::mt19937 rng(13);
   // 2 * 48^2 = 4,608 and 2 * 60^2 = 7,200 vertices: chunks of their own; the small ones are
-  // grouped with their neighbours in the breadth-first order.
+  // grouped with their neighbours in the order of their lowest vertex.
   const Graph g = disjoint_union(rng, {48, 60, 5, 3, 48, 7}, 1'000'000);
   bool exists = false;
   const std::int64_t want = lemon_min(g, exists);

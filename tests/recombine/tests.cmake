@@ -2,6 +2,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   recombine/quad_quality_test.cpp
   recombine/blossom_optimality_test.cpp
   recombine/blossom_solver_test.cpp
+  recombine/event_queue_test.cpp
   recombine/boundary_slide_test.cpp
   recombine/smoothing_test.cpp
   recombine/quad_cleanup_test.cpp
