@@ -44,7 +44,6 @@
 #include <mutex>
 
 #include "event_queue.hpp"
-#include "huge_page_allocator.hpp"
 #include "quadval/error.hpp"
 
 namespace quadval::recombine_detail {
@@ -747,12 +746,10 @@ class Solver {
   }
 
   std::uint32_t n_;
-  // The arrays read at random, per vertex or node, on huge pages (huge_page_allocator.hpp):
-  // square-hole-1M, solver alone, medians of 8 alternating runs, 10.25 -> 9.74 s.
-  HugePageVector<CostEdge> edges_;  // costs doubled
+  std::vector<CostEdge> edges_;  // costs doubled
   const MatchingProgress& progress_;
   std::uint32_t free_at_start_ = 0;
-  HugePageVector<std::uint32_t> offsets_, incident_;
+  std::vector<std::uint32_t> offsets_, incident_;
   // What growing a tree reads of an edge's far end, in one cache line (the solver waits on
   // memory; square-hole-1M's matching: 19.4 -> 15.1 s, medians of 5, against one array per
   // field). Record k holds vertex k's fields (k < n), group k's and node k's: the three
@@ -775,21 +772,20 @@ class Solver {
     std::int32_t parent = kNone;    // node: the blossom containing it, or kNone
     std::uint32_t base = 0;         // node: its base vertex
   };
-  HugePageVector<Slot> slot_;
+  std::vector<Slot> slot_;
   std::uint32_t num_groups_ = 0, num_nodes_ = 0;
   std::vector<std::uint32_t> free_groups_;
-  HugePageVector<std::uint32_t> group_of_, size_, big_child_;  // per node (top-level: its group)
+  std::vector<std::uint32_t> group_of_, size_, big_child_;  // per node (top-level: its group)
   // Per node: vertices 0..n-1, blossoms from n on.
-  HugePageVector<std::int64_t> z_;
+  std::vector<std::int64_t> z_;
   std::vector<std::vector<std::uint32_t>> childs_;  // blossoms: the odd cycle, base first
   std::vector<std::vector<std::int32_t>> endps_;    // edge i joins childs i and i + 1
   std::vector<std::vector<std::uint32_t>> trees_;   // per tree: the nodes it labelled
   std::vector<std::vector<std::uint32_t>> parked_;  // per tree: edges parked with it (see park)
   std::uint32_t alive_trees_ = 0;
-  HugePageVector<std::uint32_t> mark_;
-  std::vector<std::uint32_t> free_ids_, stack_, minus_vertices_;
-  HugePageVector<std::vector<std::uint32_t>> boundary_;  // per group (blossom groups only)
-  HugePageVector<std::uint32_t> listed_in_;            // per vertex: the group listing it
+  std::vector<std::uint32_t> mark_, free_ids_, stack_, minus_vertices_;
+  std::vector<std::vector<std::uint32_t>> boundary_;  // per group (blossom groups only)
+  std::vector<std::uint32_t> listed_in_;              // per vertex: the group listing it
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work_;
   std::uint32_t stamp_ = 0;
   std::int64_t eps_ = 0;
