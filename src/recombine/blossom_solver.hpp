@@ -11,8 +11,11 @@
 // with a hole, 100k triangles: 0.76 s vs 0.71 s; 300k: 3.8 s vs 4.3 s). The solver waits on
 // memory, so the vertex order matters: a breadth-first renumbering gained (CPU time, medians of
 // 3) square-hole-100k 0.77 -> 0.55 s, square-hole-300k 3.43 -> 2.60 s, uniform-100k 7.95 ->
-// 4.15 s over Gmsh's numbering; recombine's Z-order (node_order.hpp), now kept as given (see
-// component_order in the .cpp), does better still on square-hole-1M.
+// 4.15 s over Gmsh's numbering; recombine's Z-order (node_order.hpp), now kept as given in
+// memory (component_order in the .cpp) while the start still visits the vertices breadth
+// first (breadth_first_visit), does better still: the solver alone, alternating runs,
+// square-hole-1M 9.5-11.6 -> 8.3-10.8 s (medians 11.1 -> 9.2 s), uniform-1000k-a5 4.0-4.8 ->
+// 3.4-4.2 s, box-130k-a6 0.53-0.62 -> 0.45-0.50 s.
 //
 // Both solvers grow faster than linearly on large meshes, and the time goes to the last
 // augmentations. Measured (event counts per augmentation): on square-hole-100k the first 7,000
