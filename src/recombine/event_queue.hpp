@@ -8,14 +8,15 @@
 // reached it, so before every event in the lane.
 //
 // The heap is 4-ary, of 16-byte entries (a 32-bit queue order): half the levels of a binary
-// heap, and the four children of an entry are 64 contiguous bytes. On square-hole-1M, whose
-// grow heap holds 284k entries on average (450k at most), pops took a fifth of the solver's
-// time in a binary heap of 24-byte entries. Counted by cachegrind (the same run every time,
-// where wall times on this machine vary by 20%), the solver on square-hole-1M: L1 data misses
-// 268M -> 220M, instructions 10.5G -> 11.4G. Radix heaps (keys are integers that never fall
-// below the last popped) did no better: by bit, 12.1G instructions (keys span about 2^31, so
-// an entry moves down up to 31 times); by byte, 10.8G instructions, 200M L1 misses but 11% more
-// last-level misses.
+// heap, and the four children of an entry are 64 contiguous bytes (one or two cache lines,
+// where a binary heap takes one per level). On square-hole-1M, whose grow heap holds 284k
+// entries on average (450k at most), pops took a fifth of the solver's time in a binary heap
+// of 24-byte entries. Counted by cachegrind (the same run every time, where wall times on
+// this machine vary by 20%), the solver on square-hole-1M: L1 data misses 268M -> 220M,
+// instructions 10.5G -> 11.4G. Radix heaps (keys are integers that never fall below the last
+// popped) did no better: by bit, 12.1G instructions (keys span about 2^31, so an entry moves
+// down up to 31 times); by byte, 10.8G instructions, 200M L1 misses but 11% more last-level
+// misses.
 
 #include <algorithm>
 #include <cstdint>
