@@ -8,33 +8,16 @@
 
 namespace quadval::recombine_detail {
 
-double smoothing_score(const std::vector<double>& coords, const std::array<NodeIndex, 4>& element,
-                       const std::array<double, 3>& normal, double normal_length) noexcept {
-  if (element[3] == kNoNode) return -2.0;  // not a quad: callers use element_score
-  if (normal_length == 0.0) return -1.0;   // quad_eta: degenerate; corner sine: -1
-  // The operations of quad_eta and quad_min_corner_sine, in their order, so the value is the
-  // same to the bit; but each edge and its length once (corner k's backward edge is exactly
-  // minus edge k-1), not twice.
-  double edge[4][3], length[4];
-  for (int k = 0; k < 4; ++k) {
-    const double* p = coords.data() + 3 * std::size_t{element[k]};
-    const double* q = coords.data() + 3 * std::size_t{element[(k + 1) % 4]};
-    for (int d = 0; d < 3; ++d) edge[k][d] = q[d] - p[d];
-    length[k] =
-        std::sqrt(edge[k][0] * edge[k][0] + edge[k][1] * edge[k][1] + edge[k][2] * edge[k][2]);
-  }
+namespace {
+
+// The score from a quad's corners, the last step of smoothing_score and smoothing_scores4:
+// per corner k, turn[k] = (forward x backward edge) . normal, lengths[k] = the product of the
+// two edges' lengths, cosine[k] = |forward . backward|. @pre normal_length != 0
+double score_of_corners(const double turn[4], const double lengths[4], const double cosine[4],
+                        double normal_length) noexcept {
   bool valid = true;
-  double turn[4], lengths[4], cosine[4];  // per corner
-  for (int k = 0; k < 4; ++k) {
-    const double* f = edge[k];
-    const double b[3] = {-edge[(k + 3) % 4][0], -edge[(k + 3) % 4][1], -edge[(k + 3) % 4][2]};
-    lengths[k] = length[k] * length[(k + 3) % 4];
-    const double cr[3] = {f[1] * b[2] - f[2] * b[1], f[2] * b[0] - f[0] * b[2],
-                          f[0] * b[1] - f[1] * b[0]};
-    turn[k] = cr[0] * normal[0] + cr[1] * normal[1] + cr[2] * normal[2];
-    cosine[k] = std::abs(f[0] * b[0] + f[1] * b[1] + f[2] * b[2]);
+  for (int k = 0; k < 4; ++k)
     if (lengths[k] == 0.0 || turn[k] <= 0.0) valid = false;  // degenerate, reflex or inverted
-  }
   if (valid) {
     double worst_cos = 0.0;
     for (int k = 0; k < 4; ++k) worst_cos = std::max(worst_cos, cosine[k] / lengths[k]);
@@ -50,6 +33,36 @@ double smoothing_score(const std::vector<double>& coords, const std::array<NodeI
     worst_sine = std::min(worst_sine, turn[k] / scale);
   }
   return std::min(worst_sine, 0.0);
+}
+
+}  // namespace
+
+double smoothing_score(const std::vector<double>& coords, const std::array<NodeIndex, 4>& element,
+                       const std::array<double, 3>& normal, double normal_length) noexcept {
+  if (element[3] == kNoNode) return -2.0;  // not a quad: callers use element_score
+  if (normal_length == 0.0) return -1.0;   // quad_eta: degenerate; corner sine: -1
+  // The operations of quad_eta and quad_min_corner_sine, in their order, so the value is the
+  // same to the bit; but each edge and its length once (corner k's backward edge is exactly
+  // minus edge k-1), not twice.
+  double edge[4][3], length[4];
+  for (int k = 0; k < 4; ++k) {
+    const double* p = coords.data() + 3 * std::size_t{element[k]};
+    const double* q = coords.data() + 3 * std::size_t{element[(k + 1) % 4]};
+    for (int d = 0; d < 3; ++d) edge[k][d] = q[d] - p[d];
+    length[k] =
+        std::sqrt(edge[k][0] * edge[k][0] + edge[k][1] * edge[k][1] + edge[k][2] * edge[k][2]);
+  }
+  double turn[4], lengths[4], cosine[4];  // per corner
+  for (int k = 0; k < 4; ++k) {
+    const double* f = edge[k];
+    const double b[3] = {-edge[(k + 3) % 4][0], -edge[(k + 3) % 4][1], -edge[(k + 3) % 4][2]};
+    lengths[k] = length[k] * length[(k + 3) % 4];
+    const double cr[3] = {f[1] * b[2] - f[2] * b[1], f[2] * b[0] - f[0] * b[2],
+                          f[0] * b[1] - f[1] * b[0]};
+    turn[k] = cr[0] * normal[0] + cr[1] * normal[1] + cr[2] * normal[2];
+    cosine[k] = std::abs(f[0] * b[0] + f[1] * b[1] + f[2] * b[2]);
+  }
+  return score_of_corners(turn, lengths, cosine, normal_length);
 }
 
 void smoothing_scores4(const std::vector<double>& coords, const std::array<NodeIndex, 4>* const quads[4],
@@ -83,32 +96,17 @@ void smoothing_scores4(const std::vector<double>& coords, const std::array<NodeI
     cosine[k] = f[0] * b[0] + f[1] * b[1] + f[2] * b[2];
   }
   for (int l = 0; l < count; ++l) {
-    const double normal_length = normal_lengths[l];
-    if (normal_length == 0.0) {
+    if (normal_lengths[l] == 0.0) {
       out[l] = -1.0;
       continue;
     }
-    bool valid = true;
-    for (int k = 0; k < 4; ++k)
-      if (lengths[k][l] == 0.0 || turn[k][l] <= 0.0) valid = false;
-    if (valid) {
-      double worst_cos = 0.0;
-      for (int k = 0; k < 4; ++k) worst_cos = std::max(worst_cos, std::abs(cosine[k][l]) / lengths[k][l]);
-      const double worst_deviation = std::asin(std::min(worst_cos, 1.0));
-      const double eta = std::max(1.0 - worst_deviation / (std::numbers::pi / 2), 0.0);
-      if (eta > 0.0) {
-        out[l] = eta;
-        continue;
-      }
+    double t[4], len[4], c[4];
+    for (int k = 0; k < 4; ++k) {
+      t[k] = turn[k][l];
+      len[k] = lengths[k][l];
+      c[k] = std::abs(cosine[k][l]);
     }
-    double worst_sine = 1.0;
-    bool degenerate = false;
-    for (int k = 0; k < 4 && !degenerate; ++k) {
-      const double scale = lengths[k][l] * normal_length;
-      if (scale == 0.0) degenerate = true;
-      else worst_sine = std::min(worst_sine, turn[k][l] / scale);
-    }
-    out[l] = degenerate ? -1.0 : std::min(worst_sine, 0.0);
+    out[l] = score_of_corners(t, len, c, normal_lengths[l]);
   }
 }
 
