@@ -197,26 +197,26 @@ void halve(const Box& box, int d, Box& low, Box& high) {
 // each entry within box.err), in lanes: each one's certified lower bound of R into
 // ratio[i], and with `upper` set, the upper bound of R from Rayleigh quotients of W there
 // folded into *upper. false where a metric is not certified positive definite.
+// Four lanes on every target: the 4 corners fill them (with 8-lane AVX-512 registers, a loop
+// over 4 / kNativeLanes parts ran no part at all and left `ratio` unwritten).
 bool corner_ratios(const Box& box, const int* qs, double* ratio, double* upper) {
-  constexpr int kW = kNativeLanes;
+  constexpr int kW = 4;
   if (!(box.err < kMax)) return false;
-  for (int part = 0; part < 4 / kW; ++part) {
-    Lanes<kW> m[6], wv[3][3];
-    for (int l = 0; l < kW; ++l) {
-      const int q = qs[kW * part + l];
-      for (int e = 0; e < 6; ++e) m[e][l] = box.m[e][q];
-      for (int j = 0; j < 3; ++j)
-        for (int c = 0; c < 3; ++c) wv[j][c][l] = box.w[j][q][c];
-    }
-    const ExtremeEigen<kW> eig = extreme_eigen<kW>(m, broadcast_lanes<kW>(box.err));
-    if (mask_bits<kW>(eig.ok & (eig.lo > 0)) != (1u << kW) - 1) return false;
-    const Lanes<kW> r = down<kW>(eig.lo / eig.hi);
-    for (int l = 0; l < kW; ++l) ratio[kW * part + l] = r[l];
-    if (upper == nullptr) continue;
-    Mask<kW> vectors_ok;
-    const Lanes<kW> u = ratio_upper<kW>(wv, m, eig.lo, eig.hi, broadcast_lanes<kW>(box.delta), vectors_ok);
-    for (int l = 0; l < kW; ++l) *upper = std::min(*upper, u[l]);
+  Lanes<kW> m[6], wv[3][3];
+  for (int l = 0; l < kW; ++l) {
+    const int q = qs[l];
+    for (int e = 0; e < 6; ++e) m[e][l] = box.m[e][q];
+    for (int j = 0; j < 3; ++j)
+      for (int c = 0; c < 3; ++c) wv[j][c][l] = box.w[j][q][c];
   }
+  const ExtremeEigen<kW> eig = extreme_eigen<kW>(m, broadcast_lanes<kW>(box.err));
+  if (mask_bits<kW>(eig.ok & (eig.lo > 0)) != (1u << kW) - 1) return false;
+  const Lanes<kW> r = down<kW>(eig.lo / eig.hi);
+  for (int l = 0; l < kW; ++l) ratio[l] = r[l];
+  if (upper == nullptr) return true;
+  Mask<kW> vectors_ok;
+  const Lanes<kW> u = ratio_upper<kW>(wv, m, eig.lo, eig.hi, broadcast_lanes<kW>(box.delta), vectors_ok);
+  for (int l = 0; l < kW; ++l) *upper = std::min(*upper, u[l]);
   return true;
 }
 

@@ -74,7 +74,7 @@ TEST(BilinearQuadLanes, RectanglesAndParallelogramsInEveryLane) {
   Lanes<kW> rect[8] = {}, para[8] = {}, beta[2] = {}, margin{};
   double ratio[kW], angle[kW];
   for (int l = 0; l < kW; ++l) {
-    const double s = std::ldexp(1.0, 9 * l - 14), b = 0.2 + 0.15 * l;
+    const double s = std::ldexp(1.0, 9 * l - 14), b = 0.2 + 0.1 * l;  // below 1 in all 8 lanes
     ratio[l] = b;
     angle[l] = 0.3 + 0.35 * l;
     const double r[4][2] = {{0, 0}, {s, 0}, {s, b * s}, {0, b * s}};
