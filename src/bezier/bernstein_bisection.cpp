@@ -174,64 +174,47 @@ inline void casteljau_unrolled(const std::size_t* at, Load load, Store store, Av
     store(keep_b, at[M - r], w[M - r]);
   }
 }
+
+constexpr int kMaxRegisterLine = 16;
 #endif
 
 #if defined(__AVX512F__)
-// The de Casteljau triangle of up to 8 parallel lines whose length m + 1 is a constant, so
-// that the whole triangle stays in registers: lane j holds the line whose coefficient i
-// sits at at[i] + lane_offset[j] (kContiguous: at[i] + j, one vector load or store),
-// lanes outside `mask` are zero and never stored. The same averages, in the same order,
-// as casteljau_lanes (bit-identical).
-constexpr int kMaxRegisterLine = 16;
-
-// Lane j at j * step from lane 0.
-struct LaneOffsets {
-  explicit LaneOffsets(std::size_t step) {
-    const auto s = static_cast<long long>(step);
-    v = _mm512_set_epi64(7 * s, 6 * s, 5 * s, 4 * s, 3 * s, 2 * s, s, 0);
-  }
-  __m512i v;
-};
-
-template <int M, bool kContiguous>
-void casteljau_registers(const double* src, const std::size_t* at, const LaneOffsets& lanes, __mmask8 mask,
-                         double* keep_a, double* keep_b) {
-  const __m512i lane_offset = lanes.v;
-  const auto load = [&](std::size_t off) {
-    if constexpr (kContiguous) return _mm512_maskz_loadu_pd(mask, src + off);
-    return _mm512_mask_i64gather_pd(_mm512_setzero_pd(), mask,
-                                    _mm512_add_epi64(lane_offset, _mm512_set1_epi64(static_cast<long long>(off))), src, 8);
-  };
-  const auto store = [&](double* out, std::size_t off, __m512d x) {
-    if constexpr (kContiguous)
-      _mm512_mask_storeu_pd(out + off, mask, x);
-    else
-      _mm512_mask_i64scatter_pd(out, mask, _mm512_add_epi64(lane_offset, _mm512_set1_epi64(static_cast<long long>(off))),
-                                x, 8);
-  };
+// The de Casteljau triangle of up to 8 lines side by side (lane j holds the line whose
+// coefficient i sits at at[i] + j: one masked vector load or store) whose length m + 1 is a
+// constant, so that the whole triangle stays in registers; lanes outside `mask` are zero and
+// never stored. The same averages, in the same order, as casteljau_lanes (bit-identical).
+// Strided lines go to the scalar-load kernels below instead: on an AMD Zen 4 core, gathering
+// and scattering them (one index vector per coefficient) took 2.7 times as long for the
+// validity of warped_tetrahedron_o3 (one thread, best of 5: 12.1 -> 4.5 ms; its scaled
+// Jacobian 69 -> 53 ms, mixed_h0.6_o2's 36 -> 32 ms; the rest the same or faster).
+template <int M>
+void casteljau_registers(const double* src, const std::size_t* at, __mmask8 mask, double* keep_a, double* keep_b) {
+  const auto load = [&](std::size_t off) { return _mm512_maskz_loadu_pd(mask, src + off); };
+  const auto store = [&](double* out, std::size_t off, __m512d x) { _mm512_mask_storeu_pd(out + off, mask, x); };
   const __m512d half = _mm512_set1_pd(0.5);
   casteljau_unrolled<M, __m512d>(
       at, load, store, [&](__m512d x, __m512d y) { return _mm512_mul_pd(_mm512_add_pd(x, y), half); }, keep_a,
       keep_b);
 }
 
-using RegisterKernel = void (*)(const double*, const std::size_t*, const LaneOffsets&, __mmask8, double*, double*);
-template <bool kContiguous, int... M>
+using RegisterKernel = void (*)(const double*, const std::size_t*, __mmask8, double*, double*);
+template <int... M>
 constexpr std::array<RegisterKernel, sizeof...(M)> register_kernels(std::integer_sequence<int, M...>) {
-  return {&casteljau_registers<M, kContiguous>...};
+  return {&casteljau_registers<M>...};
 }
-constexpr std::array<std::array<RegisterKernel, kMaxRegisterLine + 1>, 2> kRegisterKernels = {
-    register_kernels<false>(std::make_integer_sequence<int, kMaxRegisterLine + 1>()),
-    register_kernels<true>(std::make_integer_sequence<int, kMaxRegisterLine + 1>())};
-#elif defined(__AVX2__)
-// Without AVX-512: the de Casteljau triangle of N <= 4 lanes (lane v: a vector's line or
-// a neighbouring line, its coefficient i at v * size + at[i]) of degree M a constant, so
+constexpr std::array<RegisterKernel, kMaxRegisterLine + 1> kRegisterKernels =
+    register_kernels(std::make_integer_sequence<int, kMaxRegisterLine + 1>());
+#endif
+
+#if defined(__AVX2__)
+// The de Casteljau triangle of N <= 4 lanes (lane v: a vector's line or a neighbouring
+// line, its coefficient i at v * size + at[i]), loaded and stored one double at a time, of
+// degree M a constant, so
 // that the triangle is unrolled into registers: no loop exits to mispredict, which cost
 // more than the averages themselves (a degree-12 tetrahedron's 91 lines of 1 to 13
 // coefficients: 3.1 us per halving of one vector with the loops). Lanes past N are zero
 // and never stored. The same averages, in the same order, as casteljau_lanes and the
 // per-vector lanes of bisect() (bit-identical).
-constexpr int kMaxRegisterLine = 16;
 
 template <int M, std::size_t N>
 void casteljau_avx2(const double* src, const std::size_t* at, std::size_t size, double* keep_a, double* keep_b) {
@@ -289,9 +272,6 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
   const std::size_t run = side_by_side ? static_cast<std::size_t>(stride) : bases.size();
   const std::size_t lane = side_by_side ? 1 : static_cast<std::size_t>(stride_[1]);
   if (run >= kRun / 2) {
-#if defined(__AVX512F__)
-    const LaneOffsets strided_lanes(lane);
-#endif
     alignas(64) double w[kMaxLine][kRun];
     std::array<std::size_t, kMaxLine> offset;
     for (std::size_t v = 0; v < count; ++v) {
@@ -309,12 +289,13 @@ void BernsteinBisection::bisect(const double* in, std::size_t count, std::size_t
               offset[static_cast<std::size_t>(i)] = first + static_cast<std::size_t>(stride * idx[i]);
             const std::size_t width = std::min(kRun, run - j0);
 #if defined(__AVX512F__)
-            if (m <= kMaxRegisterLine) {
-              kRegisterKernels[side_by_side ? 1 : 0][static_cast<std::size_t>(m)](
-                  src, offset.data(), strided_lanes, static_cast<__mmask8>((1u << width) - 1), ka, kb);
+            if (m <= kMaxRegisterLine && side_by_side) {
+              kRegisterKernels[static_cast<std::size_t>(m)](src, offset.data(),
+                                                            static_cast<__mmask8>((1u << width) - 1), ka, kb);
               continue;
             }
-#elif defined(__AVX2__)
+#endif
+#if defined(__AVX2__)
             if (m <= kMaxRegisterLine) {
               const std::size_t step = side_by_side ? 1 : lane;
               for (std::size_t h = 0; h < width; h += 4)
@@ -358,14 +339,8 @@ void BernsteinBisection::bisect_vector_lanes(const double* in, std::size_t count
   // The longest line along an edge of a simplex factor of degree n: n + 1 coefficients.
   const auto longest = static_cast<std::size_t>(factors_[f].degree) + 1;
   QV_ASSERT(longest <= kMaxLine, "line of " << longest << " coefficients");
-#if defined(__AVX512F__)
-  const LaneOffsets vector_lanes(size);
-#endif
   for (std::size_t g0 = 0; g0 < count; g0 += G) {
     const std::size_t n = std::min(G, count - g0);
-#if defined(__AVX512F__)
-    const auto mask = static_cast<__mmask8>((1u << n) - 1);
-#endif
     for (std::size_t i = 0; i < longest; ++i)
       for (std::size_t v = n; v < G; ++v) w[i * G + v] = 0.0;
     const double* src = in + g0 * size;
@@ -377,14 +352,11 @@ void BernsteinBisection::bisect_vector_lanes(const double* in, std::size_t count
         const int m = el.first[l + 1] - el.first[l] - 1;
         for (int i = 0; i <= m; ++i)
           at[static_cast<std::size_t>(i)] = static_cast<std::size_t>(base + stride * idx[i]);
-#if defined(__AVX512F__)
+#if defined(__AVX2__)
         if (m <= kMaxRegisterLine) {
-          kRegisterKernels[0][static_cast<std::size_t>(m)](src, at.data(), vector_lanes, mask, ka, kb);
-          continue;
-        }
-#elif defined(__AVX2__)
-        if (G == 4 && m <= kMaxRegisterLine) {
-          kAvx2Kernels[n - 1][static_cast<std::size_t>(m)](src, at.data(), size, ka, kb);
+          for (std::size_t h = 0; h < n; h += 4)  // vectors h .. h + 3
+            kAvx2Kernels[std::min<std::size_t>(4, n - h) - 1][static_cast<std::size_t>(m)](
+                src + h * size, at.data(), size, ka + h * size, kb + h * size);
           continue;
         }
 #endif
