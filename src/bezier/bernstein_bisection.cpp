@@ -209,11 +209,10 @@ constexpr std::array<RegisterKernel, kMaxRegisterLine + 1> kRegisterKernels =
 #if defined(__AVX2__)
 // The de Casteljau triangle of N <= 4 lanes (lane v: a vector's line or a neighbouring
 // line, its coefficient i at v * size + at[i]), loaded and stored one double at a time, of
-// degree M a constant, so
-// that the triangle is unrolled into registers: no loop exits to mispredict, which cost
-// more than the averages themselves (a degree-12 tetrahedron's 91 lines of 1 to 13
-// coefficients: 3.1 us per halving of one vector with the loops). Lanes past N are zero
-// and never stored. The same averages, in the same order, as casteljau_lanes and the
+// degree M a constant, so that the triangle is unrolled into registers: no loop exits to
+// mispredict, which cost more than the averages themselves (a degree-12 tetrahedron's 91
+// lines of 1 to 13 coefficients: 3.1 us per halving of one vector with the loops). Lanes
+// past N are zero and never stored. The same averages, in the same order, as casteljau_lanes and the
 // per-vector lanes of bisect() (bit-identical).
 
 template <int M, std::size_t N>
