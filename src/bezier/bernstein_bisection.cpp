@@ -212,8 +212,8 @@ constexpr std::array<RegisterKernel, kMaxRegisterLine + 1> kRegisterKernels =
 // degree M a constant, so that the triangle is unrolled into registers: no loop exits to
 // mispredict, which cost more than the averages themselves (a degree-12 tetrahedron's 91
 // lines of 1 to 13 coefficients: 3.1 us per halving of one vector with the loops). Lanes
-// past N are zero and never stored. The same averages, in the same order, as casteljau_lanes and the
-// per-vector lanes of bisect() (bit-identical).
+// past N are zero and never stored. The same averages, in the same order, as casteljau_lanes
+// and the per-vector lanes of bisect() (bit-identical).
 
 template <int M, std::size_t N>
 void casteljau_avx2(const double* src, const std::size_t* at, std::size_t size, double* keep_a, double* keep_b) {
