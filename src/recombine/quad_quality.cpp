@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include "eta_of_cosine.hpp"
 
 namespace quadval {
 
@@ -35,8 +36,7 @@ QuadEta quad_eta(const QuadCorners& x, const std::array<double, 3>& normal) noex
     worst_cos = std::max(worst_cos, std::abs(dot(forward, backward)) / lengths);
   }
   if (invalid) return {0.0, QuadShape::ok};
-  const double worst_deviation = std::asin(std::min(worst_cos, 1.0));
-  return {std::max(1.0 - worst_deviation / (std::numbers::pi / 2), 0.0), QuadShape::ok};
+  return {recombine_detail::eta_of_cosine(std::min(worst_cos, 1.0)), QuadShape::ok};
 }
 
 QuadEta quad_eta(const QuadCorners& x) noexcept {

@@ -4,15 +4,29 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <numbers>
+
+#include "eta_of_cosine.hpp"
 
 namespace quadval::recombine_detail {
 
 namespace {
 
-// The score from a quad's corners, the last step of smoothing_score and smoothing_scores4:
-// per corner k, turn[k] = (forward x backward edge) . normal, lengths[k] = the product of the
-// two edges' lengths, cosine[k] = |forward . backward|. @pre normal_length != 0
+// The score of a quad that is not valid with eta > 0: min(least corner sine, 0), or -1 where
+// a corner is degenerate. @pre normal_length != 0
+double sine_score(const double turn[4], const double lengths[4], double normal_length) noexcept {
+  double worst_sine = 1.0;
+  for (int k = 0; k < 4; ++k) {
+    const double scale = lengths[k] * normal_length;
+    if (scale == 0.0) return -1.0;
+    worst_sine = std::min(worst_sine, turn[k] / scale);
+  }
+  return std::min(worst_sine, 0.0);
+}
+
+// The score from a quad's corners, the last step of smoothing_score: per corner k,
+// turn[k] = (forward x backward edge) . normal, lengths[k] = the product of the two edges'
+// lengths, cosine[k] = |forward . backward|. smoothing_scores4 does the same in lanes.
+// @pre normal_length != 0
 double score_of_corners(const double turn[4], const double lengths[4], const double cosine[4],
                         double normal_length) noexcept {
   bool valid = true;
@@ -21,18 +35,10 @@ double score_of_corners(const double turn[4], const double lengths[4], const dou
   if (valid) {
     double worst_cos = 0.0;
     for (int k = 0; k < 4; ++k) worst_cos = std::max(worst_cos, cosine[k] / lengths[k]);
-    // eta (eq. 3): the worst corner deviates from pi/2 by asin(|cos|).
-    const double worst_deviation = std::asin(std::min(worst_cos, 1.0));
-    const double eta = std::max(1.0 - worst_deviation / (std::numbers::pi / 2), 0.0);
+    const double eta = eta_of_cosine(std::min(worst_cos, 1.0));  // eq. 3
     if (eta > 0.0) return eta;
   }
-  double worst_sine = 1.0;
-  for (int k = 0; k < 4; ++k) {
-    const double scale = lengths[k] * normal_length;
-    if (scale == 0.0) return -1.0;
-    worst_sine = std::min(worst_sine, turn[k] / scale);
-  }
-  return std::min(worst_sine, 0.0);
+  return sine_score(turn, lengths, normal_length);
 }
 
 }  // namespace
@@ -68,7 +74,7 @@ double smoothing_score(const std::vector<double>& coords, const std::array<NodeI
 void smoothing_scores4(const std::vector<double>& coords, const std::array<NodeIndex, 4>* const quads[4],
                        const std::array<double, 3>* const normals[4], const double normal_lengths[4], int count,
                        double out[4]) noexcept {
-  using V = double __attribute__((vector_size(32)));  // four lanes, one quad each
+  using V = EtaLanes;  // four lanes, one quad each
   // Corner positions and normals, lane by lane (unused lanes repeat lane 0).
   V x[4][3], n[3];
   for (int l = 0; l < 4; ++l) {
@@ -95,18 +101,27 @@ void smoothing_scores4(const std::vector<double>& coords, const std::array<NodeI
     turn[k] = cr[0] * n[0] + cr[1] * n[1] + cr[2] * n[2];
     cosine[k] = f[0] * b[0] + f[1] * b[1] + f[2] * b[2];
   }
+  // score_of_corners in lanes: validity, the worst cosine (garbage in the lanes of a
+  // degenerate corner, which are not valid) and eta.
+  auto valid = lengths[0] != 0.0 && turn[0] > 0.0;
+  for (int k = 1; k < 4; ++k) valid = valid && lengths[k] != 0.0 && turn[k] > 0.0;
+  V worst_cos = {0, 0, 0, 0};
+  for (int k = 0; k < 4; ++k) {
+    const V c = (cosine[k] < 0.0 ? -cosine[k] : cosine[k]) / lengths[k];
+    worst_cos = worst_cos < c ? c : worst_cos;  // std::max
+  }
+  const V one = {1, 1, 1, 1};
+  const V eta = eta_of_cosine(one < worst_cos ? one : worst_cos);  // std::min
   for (int l = 0; l < count; ++l) {
     if (normal_lengths[l] == 0.0) {
       out[l] = -1.0;
-      continue;
+    } else if (valid[l] && eta[l] > 0.0) {
+      out[l] = eta[l];
+    } else {
+      const double t[4] = {turn[0][l], turn[1][l], turn[2][l], turn[3][l]};
+      const double len[4] = {lengths[0][l], lengths[1][l], lengths[2][l], lengths[3][l]};
+      out[l] = sine_score(t, len, normal_lengths[l]);
     }
-    double t[4], len[4], c[4];
-    for (int k = 0; k < 4; ++k) {
-      t[k] = turn[k][l];
-      len[k] = lengths[k][l];
-      c[k] = std::abs(cosine[k][l]);
-    }
-    out[l] = score_of_corners(t, len, c, normal_lengths[l]);
   }
 }
 
@@ -238,8 +253,8 @@ class Smoother {
   }
   bool try_move(NodeIndex v, bool raise_mean, double global_min, std::vector<double>& trial);
   // The scores of the star entries [first, last) into trial[0 ..): quads four at a time
-  // (smoothing_scores4: the same values; random quads 59-73 -> 43-48 ns each, the asin per
-  // quad left), triangles by element_score. The move's test then reads them in star order.
+  // (smoothing_scores4: the same values; random quads 59-73 -> 43-48 ns each, before eta
+  // too went into lanes), triangles by element_score. The move's test then reads them in star order.
   void score_star(std::uint32_t first, std::uint32_t last, std::vector<double>& trial) const {
     trial.resize(last - first);
     const std::array<NodeIndex, 4>* quads[4];

@@ -1,8 +1,14 @@
-// eta of Paper I eq. (3) and the corner sine, against closed forms (STYLE.md §4).
+// eta of Paper I eq. (3) and the corner sine, against closed forms (STYLE.md §4); the
+// polynomial asin behind eta (eta_of_cosine.hpp) against the C library's asin.
 #include "quadval/quad_quality.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
+#include <vector>
+
+#include "recombine/eta_of_cosine.hpp"
 
 #include <gtest/gtest.h>
 
@@ -93,6 +99,55 @@ TEST(QuadQuality, EtaOfParallelogramsMatchesClosedFormOnASweep) {
     EXPECT_NEAR(quad_eta(parallelogram(a), {0, 0, 1}).eta, 1.0 - std::abs(kPi / 2 - a) / (kPi / 2),
                 1e-9)
         << "angle " << i << " degrees";
+  }
+}
+
+// eta = 1 - asin(c) / (pi / 2), against asinl (long double) on a dense sweep of [0, 1] and
+// the doubles next to the branch point 1/2 and to 1: within 2.5e-16 (about one unit in the
+// last place of values near 1), and never increasing with c.
+TEST(EtaOfCosine, WithinAnUlpOfTheLibraryAsinAndMonotone) {
+  using recombine_detail::eta_of_cosine;
+  std::vector<double> cs;
+  constexpr int kSteps = 1 << 20;
+  for (int i = 0; i <= kSteps; ++i) cs.push_back(static_cast<double>(i) / kSteps);
+  for (double at : {0.5, 1.0}) {
+    double below = at, above = at;
+    for (int i = 0; i < 1000; ++i) {
+      below = std::nextafter(below, 0.0);
+      above = std::nextafter(above, 2.0);
+      cs.push_back(below);
+      if (above <= 1.0) cs.push_back(above);
+    }
+  }
+  std::sort(cs.begin(), cs.end());
+  const long double half_pi = std::acos(-1.0L) / 2;
+  double previous = 2.0, worst = 0.0;
+  for (double c : cs) {
+    const double eta = eta_of_cosine(c);
+    const auto exact = static_cast<double>(1.0L - std::asin(static_cast<long double>(c)) / half_pi);
+    worst = std::max(worst, std::abs(eta - exact));
+    EXPECT_LE(eta, previous) << "c = " << c;
+    previous = eta;
+  }
+  EXPECT_LE(worst, 2.5e-16);
+  EXPECT_EQ(eta_of_cosine(0.0), 1.0);
+  EXPECT_EQ(eta_of_cosine(1.0), 0.0);
+  EXPECT_NEAR(eta_of_cosine(0.5), 2.0 / 3.0, 2.3e-16);
+  EXPECT_NEAR(eta_of_cosine(std::sqrt(0.5)), 0.5, 2.3e-16);
+}
+
+// Four lanes give each lane's scalar value to the bit, on both sides of the branch point.
+TEST(EtaOfCosine, FourLanesEqualOneByOne) {
+  using recombine_detail::EtaLanes;
+  using recombine_detail::eta_of_cosine;
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double special[] = {0.0, 0.5, std::nextafter(0.5, 1.0), std::nextafter(0.5, 0.0), 1.0};
+  for (int i = 0; i < 100000; ++i) {
+    EtaLanes c = {unit(rng), unit(rng), unit(rng), unit(rng)};
+    if (i < 5) c[i % 4] = special[i];
+    const EtaLanes eta = eta_of_cosine(c);
+    for (int l = 0; l < 4; ++l) ASSERT_EQ(eta[l], eta_of_cosine(c[l])) << "c = " << c[l];
   }
 }
 
