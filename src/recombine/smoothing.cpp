@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 
 #include "eta_of_cosine.hpp"
 
@@ -428,6 +429,107 @@ SmoothingSweep smoothing_order(const MixedMesh& m, const std::vector<char>& fixe
   return out;
 }
 
+namespace {
+
+// The least score of these elements (element_score's values: quads four at a time).
+double least_score(const MixedMesh& m, std::span<const std::uint32_t> elements) noexcept {
+  double low = 2.0;
+  const std::array<NodeIndex, 4>* quads[4];
+  const std::array<double, 3>* normals[4];
+  double lengths[4], out[4];
+  int lanes = 0;
+  const auto flush = [&] {
+    smoothing_scores4(m.coords, quads, normals, lengths, lanes, out);
+    for (int k = 0; k < lanes; ++k) low = std::min(low, out[k]);
+    lanes = 0;
+  };
+  for (std::uint32_t e : elements) {
+    if (m.elements[e][3] == kNoNode) {
+      low = std::min(low, element_score(m, e));
+      continue;
+    }
+    const auto& n = m.normal[e];
+    quads[lanes] = &m.elements[e];
+    normals[lanes] = &n;
+    lengths[lanes] = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (++lanes == 4) flush();
+  }
+  if (lanes > 0) flush();
+  return low;
+}
+
+}  // namespace
+
+std::size_t polish_node(MixedMesh& m, NodeIndex v, std::span<const std::uint32_t> star, bool sliding,
+                        const SmoothingOptions& options) {
+  std::size_t kept = 0;
+  // Directions: the straight side, or two orthonormal tangents of the mean normal.
+  std::array<double, 3> a{}, d1{}, d2{};
+  int directions = 2;
+  double edge = 0;
+  int edges = 0;
+  const auto x0 = m.point(v);
+  std::array<double, 3> normal{0, 0, 0};
+  for (std::uint32_t e : star) {
+    for (int k = 0; k < 3; ++k) normal[k] += m.normal[e][k];
+    const auto& el = m.elements[e];
+    const auto y = m.point(next_corner(el, corner_of(el, v)));
+    edge += std::sqrt((y[0] - x0[0]) * (y[0] - x0[0]) + (y[1] - x0[1]) * (y[1] - x0[1]) +
+                      (y[2] - x0[2]) * (y[2] - x0[2]));
+    ++edges;
+  }
+  edge /= edges;
+  auto unit = [](std::array<double, 3> u) {
+    const double l = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    return std::array<double, 3>{u[0] / l, u[1] / l, u[2] / l};
+  };
+  std::array<double, 3> b{};
+  if (sliding) {
+    a = m.point((*options.slides)[v][0]);
+    b = m.point((*options.slides)[v][1]);
+    d1 = unit({b[0] - a[0], b[1] - a[1], b[2] - a[2]});
+    directions = 1;
+  } else {
+    const auto n = unit(normal);
+    // Any vector not parallel to n, made orthogonal to it; then n x d1.
+    std::array<double, 3> t = std::abs(n[0]) < 0.9 ? std::array<double, 3>{1, 0, 0}
+                                                   : std::array<double, 3>{0, 1, 0};
+    const double tn = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
+    d1 = unit({t[0] - tn * n[0], t[1] - tn * n[1], t[2] - tn * n[2]});
+    d2 = {n[1] * d1[2] - n[2] * d1[1], n[2] * d1[0] - n[0] * d1[2], n[0] * d1[1] - n[1] * d1[0]};
+  }
+  double best = least_score(m, star);
+  for (double h = 0.1 * edge; h >= 1e-3 * edge;) {
+    bool improved = false;
+    for (int k = 0; k < 2 * directions && !improved; ++k) {
+      const auto& dir = k < 2 ? d1 : d2;
+      const double step = (k % 2 == 0 ? h : -h);
+      const auto x = m.point(v);
+      const std::array<double, 3> y{x[0] + step * dir[0], x[1] + step * dir[1],
+                                    x[2] + step * dir[2]};
+      if (sliding) {  // strictly inside the side a-b
+        double s = 0, ll = 0;
+        for (int q = 0; q < 3; ++q) {
+          s += (y[q] - a[q]) * (b[q] - a[q]);
+          ll += (b[q] - a[q]) * (b[q] - a[q]);
+        }
+        if (!(s > 0 && s < ll)) continue;
+      }
+      for (int q = 0; q < 3; ++q) m.coords[3 * std::size_t{v} + q] = y[q];
+      const double trial = least_score(m, star);
+      if (trial > best) {
+        best = trial;
+        improved = true;
+        ++kept;
+      } else {
+        for (int q = 0; q < 3; ++q) m.coords[3 * std::size_t{v} + q] = x[q];
+      }
+    }
+    if (!improved) h *= 0.5;
+  }
+  return kept;
+}
+
 std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,
                          const SmoothingOptions& options, double share) {
   const std::vector<std::vector<std::uint32_t>> at = node_elements(m);
@@ -446,79 +548,32 @@ std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,
   std::sort(nodes.begin(), nodes.end());
   nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
 
-  auto local_min = [&](NodeIndex v) {
-    double low = 2.0;
-    for (std::uint32_t e : at[v]) low = std::min(low, element_score(m, e));
-    return low;
-  };
-  std::size_t kept = 0;
+  // Levels: a node's is one more than the highest of the earlier listed nodes that share an
+  // element with it. The nodes of one level share no element, so their searches read and
+  // write disjoint positions and run in parallel, and every node still sees the final
+  // positions of the earlier nodes it depends on: the result is that of the searches one
+  // after the other in node order, for any number of threads.
+  std::vector<int> level_of(m.num_nodes(), -1);
+  std::vector<std::vector<NodeIndex>> levels;
   for (NodeIndex v : nodes) {
     const bool sliding =
         fixed[v] && options.slides != nullptr && (*options.slides)[v][0] != kNoNode;
     if ((fixed[v] && !sliding) || at[v].empty()) continue;
-    // Directions: the straight side, or two orthonormal tangents of the mean normal.
-    std::array<double, 3> a{}, d1{}, d2{};
-    int directions = 2;
-    double edge = 0;
-    int edges = 0;
-    const auto x0 = m.point(v);
-    std::array<double, 3> normal{0, 0, 0};
-    for (std::uint32_t e : at[v]) {
-      for (int k = 0; k < 3; ++k) normal[k] += m.normal[e][k];
-      const auto& el = m.elements[e];
-      const auto y = m.point(next_corner(el, corner_of(el, v)));
-      edge += std::sqrt((y[0] - x0[0]) * (y[0] - x0[0]) + (y[1] - x0[1]) * (y[1] - x0[1]) +
-                        (y[2] - x0[2]) * (y[2] - x0[2]));
-      ++edges;
-    }
-    edge /= edges;
-    auto unit = [](std::array<double, 3> u) {
-      const double l = std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-      return std::array<double, 3>{u[0] / l, u[1] / l, u[2] / l};
-    };
-    std::array<double, 3> b{};
-    if (sliding) {
-      a = m.point((*options.slides)[v][0]);
-      b = m.point((*options.slides)[v][1]);
-      d1 = unit({b[0] - a[0], b[1] - a[1], b[2] - a[2]});
-      directions = 1;
-    } else {
-      const auto n = unit(normal);
-      // Any vector not parallel to n, made orthogonal to it; then n x d1.
-      std::array<double, 3> t = std::abs(n[0]) < 0.9 ? std::array<double, 3>{1, 0, 0}
-                                                     : std::array<double, 3>{0, 1, 0};
-      const double tn = t[0] * n[0] + t[1] * n[1] + t[2] * n[2];
-      d1 = unit({t[0] - tn * n[0], t[1] - tn * n[1], t[2] - tn * n[2]});
-      d2 = {n[1] * d1[2] - n[2] * d1[1], n[2] * d1[0] - n[0] * d1[2], n[0] * d1[1] - n[1] * d1[0]};
-    }
-    double best = local_min(v);
-    for (double h = 0.1 * edge; h >= 1e-3 * edge;) {
-      bool improved = false;
-      for (int k = 0; k < 2 * directions && !improved; ++k) {
-        const auto& dir = k < 2 ? d1 : d2;
-        const double step = (k % 2 == 0 ? h : -h);
-        const auto x = m.point(v);
-        const std::array<double, 3> y{x[0] + step * dir[0], x[1] + step * dir[1],
-                                      x[2] + step * dir[2]};
-        if (sliding) {  // strictly inside the side a-b
-          double s = 0, ll = 0;
-          for (int q = 0; q < 3; ++q) {
-            s += (y[q] - a[q]) * (b[q] - a[q]);
-            ll += (b[q] - a[q]) * (b[q] - a[q]);
-          }
-          if (!(s > 0 && s < ll)) continue;
-        }
-        for (int q = 0; q < 3; ++q) m.coords[3 * std::size_t{v} + q] = y[q];
-        const double trial = local_min(v);
-        if (trial > best) {
-          best = trial;
-          improved = true;
-          ++kept;
-        } else {
-          for (int q = 0; q < 3; ++q) m.coords[3 * std::size_t{v} + q] = x[q];
-        }
-      }
-      if (!improved) h *= 0.5;
+    int level = 0;
+    for (std::uint32_t e : at[v])
+      for (int c = 0; c < MixedMesh::size(m.elements[e]); ++c)
+        level = std::max(level, level_of[m.elements[e][c]] + 1);
+    level_of[v] = level;
+    if (static_cast<std::size_t>(level) == levels.size()) levels.emplace_back();
+    levels[static_cast<std::size_t>(level)].push_back(v);
+  }
+  std::size_t kept = 0;
+  for (const std::vector<NodeIndex>& level : levels) {
+    const auto size = static_cast<std::ptrdiff_t>(level.size());
+#pragma omp parallel for schedule(dynamic, 8) reduction(+ : kept) if (size > 64)
+    for (std::ptrdiff_t i = 0; i < size; ++i) {
+      const NodeIndex v = level[static_cast<std::size_t>(i)];
+      kept += polish_node(m, v, at[v], fixed[v] != 0, options);
     }
   }
   return kept;

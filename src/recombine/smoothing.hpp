@@ -4,6 +4,8 @@
 // elements around the node (so it never inverts an element: the Jacobian check).
 
 #include <cstddef>
+#include <cstdint>
+#include <span>
 #include <vector>
 
 #include "mixed_mesh.hpp"
@@ -84,7 +86,18 @@ SmoothingSweep smoothing_order(const MixedMesh& m, const std::vector<char>& fixe
 /// down to 1e-3 of it; a step is kept only when it strictly raises the worst score of the
 /// elements at the node. So the mesh's worst element never gets worse and no element is
 /// inverted (Paper I §6 asks for no inversion; the max-min search is ours). Returns moves kept.
+/// The nodes are searched by levels (a node's level is one more than the highest of the
+/// earlier listed nodes sharing an element with it), each level's in parallel (OpenMP): the
+/// same result, to the bit, as the searches one after the other in node order, for any number
+/// of threads. With the elements' scores four at a time (smoothing_scores4), square-hole-1M's
+/// polish took 300 -> 160 ms on two threads (medians of 3 runs).
 std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,
                          const SmoothingOptions& options, double share = 0.02);
+
+/// polish_worst's search at one movable node v (free, or fixed with a slide, `sliding`), whose
+/// alive elements are `star`: writes only v's position, reads only the corners of `star`.
+/// Returns the moves kept.
+std::size_t polish_node(MixedMesh& m, NodeIndex v, std::span<const std::uint32_t> star, bool sliding,
+                        const SmoothingOptions& options);
 
 }  // namespace quadval::recombine_detail

@@ -5,7 +5,8 @@
 // element_score, node_elements and corner_of: none of smooth()'s shortcuts), on one thread
 // or two; smoothing_order visits every movable node once and no two blocks of one colour
 // share an element; smooth() never lowers the worst score and inverts nothing. The last polish of the worst elements (polish_worst): a closed form, one interior
-// node pulled off the centre of 2 x 2 unit squares goes back to where all four are squares.
+// node pulled off the centre of 2 x 2 unit squares goes back to where all four are squares;
+// by levels in parallel, the same bits as node after node.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -400,6 +401,47 @@ TEST(PolishWorst, RestoresTheSquaresAroundAPulledNode) {
   for (NodeIndex v : {0u, 1u, 2u, 3u, 5u, 6u, 7u, 8u})  // corners of the square stay
     EXPECT_EQ(m.point(v)[2], 0.0);
   EXPECT_EQ(m.point(0)[0], 0.0);
+}
+
+// polish_worst, by levels on one thread or two, gives the bits of the plain order: the
+// worst elements' nodes one after the other by polish_node, ascending.
+TEST(PolishWorst, SameBitsAsTheNodesOneAfterTheOther) {
+  const MixedMesh start = jittered_mixed_grid(40, 30, 0.45, 5);
+  const std::vector<char> fixed = region_boundary_nodes(start);
+  const auto slides = straight_boundary_slides(start, fixed);
+  SmoothingOptions options;
+  options.slides = &slides;
+  constexpr double kShare = 0.1;
+
+  MixedMesh plain = start;
+  const auto at = node_elements(plain);
+  std::vector<std::pair<double, std::uint32_t>> scored;
+  for (std::size_t e = 0; e < plain.elements.size(); ++e)
+    if (plain.alive[e]) scored.push_back({element_score(plain, e), static_cast<std::uint32_t>(e)});
+  std::sort(scored.begin(), scored.end());
+  scored.resize(static_cast<std::size_t>(kShare * static_cast<double>(scored.size())));
+  std::vector<NodeIndex> nodes;
+  for (const auto& [score, e] : scored)
+    for (int c = 0; c < MixedMesh::size(plain.elements[e]); ++c) nodes.push_back(plain.elements[e][c]);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  std::size_t plain_kept = 0;
+  for (NodeIndex v : nodes) {
+    const bool sliding = fixed[v] && slides[v][0] != kNoNode;
+    if ((!fixed[v] || sliding) && !at[v].empty()) plain_kept += polish_node(plain, v, at[v], sliding, options);
+  }
+  EXPECT_GT(nodes.size(), 100u);
+  EXPECT_GT(plain_kept, 100u);
+
+  const int threads = omp_get_max_threads();
+  for (int t : {1, 2}) {
+    omp_set_num_threads(t);
+    MixedMesh m = start;
+    EXPECT_EQ(polish_worst(m, fixed, options, kShare), plain_kept) << t << " thread(s)";
+    for (std::size_t i = 0; i < m.coords.size(); ++i)
+      ASSERT_EQ(m.coords[i], plain.coords[i]) << t << " thread(s), coordinate " << i;
+  }
+  omp_set_num_threads(threads);
 }
 
 }  // namespace
