@@ -24,24 +24,6 @@ double seconds_since(Clock::time_point t) {
   return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// eta (Paper I eq. 3) of each element in block order; NaN for anything but a quadrangle, so
-// that pictures draw it grey and histograms skip it.
-std::vector<double> element_eta(const Mesh& mesh) {
-  std::vector<double> eta;
-  eta.reserve(mesh.num_elements());
-  for (const ElementBlock& b : mesh.blocks)
-    for (std::size_t e = 0; e < b.size(); ++e) {
-      if (b.type->family != ElementFamily::quadrangle) {
-        eta.push_back(std::nan(""));
-        continue;
-      }
-      const auto n = b.element(e);
-      eta.push_back(
-          quad_eta({mesh.node(n[0]), mesh.node(n[1]), mesh.node(n[2]), mesh.node(n[3])}).eta);
-    }
-  return eta;
-}
-
 void write_meshes(const Mesh& mesh, const std::vector<std::filesystem::path>& paths,
                   const std::vector<ElementField>& fields) {
   for (const auto& path : paths)
@@ -136,7 +118,8 @@ int run_geometry_pipeline(const Triangulation& tri, const PipelineSettings& sett
     }
   }
   const Mesh& final_mesh = rec ? rec->mesh : tri.mesh;
-  const std::vector<double> eta = element_eta(final_mesh);
+  // NaN for anything but a quadrangle, so that pictures draw it grey and histograms skip it.
+  const std::vector<double> eta = element_eta(final_mesh, std::nan(""));
 
   // Outputs.
   const auto write_start = Clock::now();

@@ -91,20 +91,6 @@ nlohmann::json stats_json(const RecombineStats& s) {
   return j;
 }
 
-// eta of each output element (quads; triangles get -1), in block order, for the output file.
-std::vector<double> element_eta(const Mesh& mesh) {
-  std::vector<double> eta;
-  for (const ElementBlock& b : mesh.blocks)
-    for (std::size_t e = 0; e < b.size(); ++e) {
-      if (b.type->family != ElementFamily::quadrangle) {
-        eta.push_back(-1.0);
-        continue;
-      }
-      const auto n = b.element(e);
-      eta.push_back(quad_eta({mesh.node(n[0]), mesh.node(n[1]), mesh.node(n[2]), mesh.node(n[3])}).eta);
-    }
-  return eta;
-}
 
 int run(const RecombineCliOptions& o) {
   const auto start = std::chrono::steady_clock::now();
@@ -156,7 +142,7 @@ int run(const RecombineCliOptions& o) {
   for (const auto& w : result.warnings) log(fmt::format("[recombine] warning: {}", w));
 
   const auto write_start = std::chrono::steady_clock::now();
-  const ElementField eta{"eta", element_eta(result.mesh)};
+  const ElementField eta{"eta", element_eta(result.mesh, -1.0)};  // triangles (none when all-quad): -1
   write_mesh(result.mesh, o.output, WriteOptions{format_from_extension(o.output), o.binary},
              std::span<const ElementField>(&eta, 1));
   const double write_seconds =

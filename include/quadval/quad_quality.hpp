@@ -7,6 +7,9 @@
 /// inverted, and makes the quad invalid.
 
 #include <array>
+#include <vector>
+
+#include "quadval/mesh.hpp"
 
 namespace quadval {
 
@@ -44,5 +47,9 @@ QuadEta quad_eta(const QuadCorners& x) noexcept;
 /// iff all four are > 0. Ideal 1 (rectangle); full range [-1, 1]; <= 0 invalid.
 /// Knupp (2000) "scaled Jacobian" of a quadrilateral. Degenerate input gives -1.
 double quad_min_corner_sine(const QuadCorners& x, const std::array<double, 3>& normal) noexcept;
+
+/// quad_eta (own normal) of every element of the mesh in block order, `other` for the
+/// elements that are not quadrangles; on OpenMP's threads (the values do not depend on them).
+std::vector<double> element_eta(const Mesh& mesh, double other);
 
 }  // namespace quadval

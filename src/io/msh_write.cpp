@@ -121,11 +121,11 @@ class MshWriter {
         out_.bytes(mesh_.coords.data() + 3 * b.first, 3 * b.count * sizeof(double));
       } else {
         out_.text("{} {} 0 {}\n", b.entity_dim, b.entity_tag, b.count);
-        for (std::size_t i = b.first; i < b.first + b.count; ++i) {
-          out_.integer(mesh_.node_tags[i]);
-          out_.put('\n');
-        }
-        for (std::size_t i = b.first; i < b.first + b.count; ++i) coordinates(i);
+        out_.records(b.count, [&](OutBuffer& o, std::size_t i) {
+          o.integer(mesh_.node_tags[b.first + i]);
+          o.put('\n');
+        });
+        out_.records(b.count, [&](OutBuffer& o, std::size_t i) { coordinates(o, b.first + i); });
       }
     }
     end_section("Nodes");
@@ -155,16 +155,18 @@ class MshWriter {
       } else {
         out_.text("{} {} {} {}\n", b.entity_dim, b.entity_tag, b.type->gmsh_id, b.size());
       }
+      if (!binary_) {
+        out_.records(b.size(), [&](OutBuffer& o, std::size_t e) {
+          o.integer(b.tags[e]);
+          node_tags(o, b.element(e));
+        });
+        continue;
+      }
       for (std::size_t e = 0; e < b.size(); ++e) {
-        if (binary_) {
-          record.clear();
-          record.push_back(b.tags[e]);
-          for (NodeIndex v : b.element(e)) record.push_back(mesh_.node_tags[v]);
-          out_.bytes_buffered(record.data(), record.size() * sizeof(std::uint64_t));
-        } else {
-          out_.integer(b.tags[e]);
-          node_tags(b.element(e));
-        }
+        record.clear();
+        record.push_back(b.tags[e]);
+        for (NodeIndex v : b.element(e)) record.push_back(mesh_.node_tags[v]);
+        out_.bytes_buffered(record.data(), record.size() * sizeof(std::uint64_t));
       }
     }
     end_section("Elements");
@@ -172,16 +174,17 @@ class MshWriter {
 
   void nodes22() {
     out_.text("$Nodes\n{}\n", mesh_.num_nodes());
-    for (std::size_t i = 0; i < mesh_.num_nodes(); ++i) {
-      const std::int32_t tag = int_tag(mesh_.node_tags[i], "node");
-      if (binary_) {
-        out_.raw(tag);
+    if (binary_) {
+      for (std::size_t i = 0; i < mesh_.num_nodes(); ++i) {
+        out_.raw(int_tag(mesh_.node_tags[i], "node"));
         out_.bytes_buffered(mesh_.coords.data() + 3 * i, 3 * sizeof(double));
-      } else {
-        out_.integer(tag);
-        out_.put(' ');
-        coordinates(i);
       }
+    } else {
+      out_.records(mesh_.num_nodes(), [&](OutBuffer& o, std::size_t i) {
+        o.integer(int_tag(mesh_.node_tags[i], "node"));
+        o.put(' ');
+        coordinates(o, i);
+      });
     }
     end_section("Nodes");
   }
@@ -212,17 +215,21 @@ class MshWriter {
           out_.raw(int_count(block.size()));
           out_.raw(std::int32_t{2});
         }
+        // The first group keeps the element's tags; copies for further groups get fresh ones.
+        const Tag fresh = next_tag;
+        const auto tag_of = [&](std::size_t e) { return int_tag(p == 0 ? block.tags[e] : fresh + e, "element"); };
+        if (p > 0) next_tag += block.size();
+        if (!binary_) {
+          out_.records(block.size(), [&](OutBuffer& o, std::size_t e) {
+            o.text("{} {} 2 {} {}", tag_of(e), block.type->gmsh_id, physical, elementary);
+            node_tags(o, block.element(e));
+          });
+          continue;
+        }
         for (std::size_t e = 0; e < block.size(); ++e) {
-          // The first group keeps the element's tag; copies for further groups get fresh ones.
-          const std::int32_t tag = int_tag(p == 0 ? block.tags[e] : next_tag++, "element");
-          if (binary_) {
-            record.assign({tag, physical, elementary});
-            for (NodeIndex v : block.element(e)) record.push_back(int_tag(mesh_.node_tags[v], "node"));
-            out_.bytes_buffered(record.data(), record.size() * sizeof(std::int32_t));
-          } else {
-            out_.text("{} {} 2 {} {}", tag, block.type->gmsh_id, physical, elementary);
-            node_tags(block.element(e));
-          }
+          record.assign({tag_of(e), physical, elementary});
+          for (NodeIndex v : block.element(e)) record.push_back(int_tag(mesh_.node_tags[v], "node"));
+          out_.bytes_buffered(record.data(), record.size() * sizeof(std::int32_t));
         }
       }
     }
@@ -234,20 +241,22 @@ class MshWriter {
       throw std::invalid_argument("field '" + field.name + "' has " + std::to_string(field.values.size()) +
                                   " values for " + std::to_string(mesh_.num_elements()) + " elements");
     out_.text("$ElementData\n1\n\"{}\"\n1\n0\n3\n0\n1\n{}\n", field.name, field.values.size());
-    std::size_t i = 0;
+    std::size_t first = 0;  // the block's first value
     for (const ElementBlock& b : mesh_.blocks) {
-      for (Tag t : b.tags) {
-        if (binary_) {
-          out_.raw(int_tag(t, "element"));
-          out_.raw(field.values[i]);
-        } else {
-          out_.integer(t);
-          out_.put(' ');
-          out_.real(field.values[i]);
-          out_.put('\n');
+      if (binary_) {
+        for (std::size_t e = 0; e < b.size(); ++e) {
+          out_.raw(int_tag(b.tags[e], "element"));
+          out_.raw(field.values[first + e]);
         }
-        ++i;
+      } else {
+        out_.records(b.size(), [&](OutBuffer& o, std::size_t e) {
+          o.integer(b.tags[e]);
+          o.put(' ');
+          o.real(field.values[first + e]);
+          o.put('\n');
+        });
       }
+      first += b.size();
     }
     end_section("ElementData");
   }
@@ -255,21 +264,21 @@ class MshWriter {
   void finish() { out_.flush(); }
 
   // " tag tag ... tag\n" of the element's nodes.
-  void node_tags(std::span<const NodeIndex> element) {
+  void node_tags(OutBuffer& o, std::span<const NodeIndex> element) const {
     for (NodeIndex v : element) {
-      out_.put(' ');
-      out_.integer(mesh_.node_tags[v]);
+      o.put(' ');
+      o.integer(mesh_.node_tags[v]);
     }
-    out_.put('\n');
+    o.put('\n');
   }
   // "x y z\n" of node i.
-  void coordinates(std::size_t i) {
-    out_.real(mesh_.coords[3 * i]);
-    out_.put(' ');
-    out_.real(mesh_.coords[3 * i + 1]);
-    out_.put(' ');
-    out_.real(mesh_.coords[3 * i + 2]);
-    out_.put('\n');
+  void coordinates(OutBuffer& o, std::size_t i) const {
+    o.real(mesh_.coords[3 * i]);
+    o.put(' ');
+    o.real(mesh_.coords[3 * i + 1]);
+    o.put(' ');
+    o.real(mesh_.coords[3 * i + 2]);
+    o.put('\n');
   }
 
  private:

@@ -57,4 +57,22 @@ double quad_min_corner_sine(const QuadCorners& x, const std::array<double, 3>& n
   return worst;
 }
 
+std::vector<double> element_eta(const Mesh& mesh, double other) {
+  std::vector<double> eta(mesh.num_elements(), other);
+  std::size_t first = 0;  // the block's first element
+  for (const ElementBlock& b : mesh.blocks) {
+    if (b.type->family == ElementFamily::quadrangle) {
+      const auto count = static_cast<std::ptrdiff_t>(b.size());
+#pragma omp parallel for schedule(static) if (count > 16384)
+      for (std::ptrdiff_t e = 0; e < count; ++e) {
+        const auto n = b.element(static_cast<std::size_t>(e));
+        eta[first + static_cast<std::size_t>(e)] =
+            quad_eta({mesh.node(n[0]), mesh.node(n[1]), mesh.node(n[2]), mesh.node(n[3])}).eta;
+      }
+    }
+    first += b.size();
+  }
+  return eta;
+}
+
 }  // namespace quadval

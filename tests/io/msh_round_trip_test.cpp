@@ -1,7 +1,11 @@
 // Read-write-read round trips of MSH files: exact (Mesh ==) for every Gmsh-made mesh in
 // shared/data and for random meshes of every element type, in MSH 2.2 and 4.1, ASCII and
-// binary.
+// binary; large ASCII sections (formatted on several threads) the same bytes on any
+// thread count.
 #include <gtest/gtest.h>
+#include <omp.h>
+
+#include <random>
 
 #include <fmt/core.h>
 
@@ -114,6 +118,46 @@ TEST_P(MshRandomRoundTrip, EveryFixedSizeTypeIsExact) {
 
 INSTANTIATE_TEST_SUITE_P(AllEncodings, MshRandomRoundTrip, ::testing::ValuesIn(kTargets),
                          [](const auto& info) { return std::string(info.param.name); });
+
+// 70,000 nodes (shuffled tags) and 60,000 quadrangles with an element field: ASCII 4.1 and
+// 2.2 give the same bytes on one thread and two, and read back exactly.
+TEST(MshRoundTrip, LargeAsciiSectionsSameBytesOnAnyThreadCount) {
+  ScratchDir dir("large");
+  std::mt19937_64 rng(17);
+  Mesh m;
+  constexpr std::size_t kNodes = 70000, kQuads = 60000;
+  for (std::size_t i = 0; i < kNodes; ++i) m.node_tags.push_back(3 * i + 1 + rng() % 3);
+  std::shuffle(m.node_tags.begin(), m.node_tags.end(), rng);
+  for (std::size_t i = 0; i < 3 * kNodes; ++i) m.coords.push_back(testing_io::awkward_double(rng));
+  ElementBlock quads;
+  quads.type = find_element_type(3);
+  quads.entity_dim = 2;
+  quads.entity_tag = 1;
+  for (std::size_t e = 0; e < kQuads; ++e) {
+    quads.tags.push_back(2 * e + 5);
+    for (int k = 0; k < 4; ++k) quads.nodes.push_back(static_cast<NodeIndex>(rng() % kNodes));
+  }
+  m.blocks.push_back(quads);
+  m.entities.push_back({2, 1, {}, {}, {}});
+  ElementField field{"eta", {}};
+  for (std::size_t e = 0; e < kQuads; ++e) field.values.push_back(std::ldexp(static_cast<double>(rng() % 1000003), -20));
+  const int threads = omp_get_max_threads();
+  for (MeshFormat format : {MeshFormat::msh41, MeshFormat::msh22}) {
+    std::string first;
+    for (int t : {1, 2}) {
+      omp_set_num_threads(t);
+      const auto file = dir / fmt::format("m{}.msh", t);
+      write_mesh(m, file, {format, false}, std::span<const ElementField>(&field, 1));
+      const std::string bytes = testing_io::file_bytes(file);
+      if (t == 1) first = bytes;
+      EXPECT_EQ(bytes, first) << (format == MeshFormat::msh41 ? "4.1" : "2.2");
+      std::vector<std::string> warnings;  // $ElementData is skipped on reading
+      const Mesh back = read_mesh(file, &warnings);
+      expect_same_content(m, back);
+    }
+  }
+  omp_set_num_threads(threads);
+}
 
 TEST(MshRoundTrip, Msh22WritesAnElementOncePerPhysicalGroup) {
   ScratchDir dir("physicals");

@@ -1,6 +1,8 @@
 // The writers' fast pieces (io/out_buffer.hpp): integer() and real() write exactly what
-// text("{}", v) writes, the shortest round-trip form, so that files keep their bytes.
+// text("{}", v) writes, the shortest round-trip form, so that files keep their bytes; and
+// records() on several threads writes what the plain loop writes, and fails where it fails.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <fmt/format.h>
 
@@ -10,6 +12,7 @@
 #include <limits>
 #include <random>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -95,6 +98,59 @@ TEST(OutBuffer, LongOutputKeepsItsOrderAcrossFlushes) {
   std::uint64_t expected = 0, value = 0;
   while (in >> value) ASSERT_EQ(value, expected++);
   EXPECT_EQ(expected, kCount);
+}
+
+// Record i: "i x\n" with an awkward double x, or text of varying length.
+void record(OutBuffer& b, std::size_t i) {
+  b.integer(static_cast<std::uint64_t>(i));
+  b.put(' ');
+  if (i % 7 == 0) {
+    b.text("{}", std::string(i % 23, 'a'));
+  } else {
+    b.real(std::ldexp(static_cast<double>(i) * 0.1, static_cast<int>(i % 60) - 30));
+  }
+  b.put('\n');
+}
+
+TEST(OutBuffer, RecordsWriteWhatThePlainLoopWrites) {
+  const int threads = omp_get_max_threads();
+  // Below the parallel threshold, just above, several rounds of pieces, a ragged last round.
+  for (std::size_t count : {std::size_t{0}, std::size_t{1000}, std::size_t{40000}, std::size_t{300007}}) {
+    const std::string want = written([&](OutBuffer& b) {
+      b.text("head\n");
+      for (std::size_t i = 0; i < count; ++i) record(b, i);
+      b.text("tail\n");
+    });
+    for (int t : {1, 2, 3}) {
+      omp_set_num_threads(t);
+      const std::string got = written([&](OutBuffer& b) {
+        b.text("head\n");
+        b.records(count, record);
+        b.text("tail\n");
+      });
+      EXPECT_EQ(got, want) << count << " records, " << t << " threads";
+    }
+  }
+  omp_set_num_threads(threads);
+}
+
+TEST(OutBuffer, RecordsRethrowTheFirstFailureInOrder) {
+  const int threads = omp_get_max_threads();
+  for (int t : {1, 2}) {
+    omp_set_num_threads(t);
+    std::ostringstream out;
+    OutBuffer b(out);
+    try {
+      b.records(200000, [](OutBuffer& o, std::size_t i) {
+        if (i == 150001 || i == 70003) throw std::runtime_error(fmt::format("record {}", i));
+        record(o, i);
+      });
+      ADD_FAILURE() << "no exception, " << t << " threads";
+    } catch (const std::runtime_error& e) {
+      EXPECT_EQ(std::string(e.what()), "record 70003") << t << " threads";
+    }
+  }
+  omp_set_num_threads(threads);
 }
 
 }  // namespace
