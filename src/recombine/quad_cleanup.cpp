@@ -399,12 +399,19 @@ std::size_t swap_worst(MixedMesh& m, const std::vector<char>& fixed, double shar
   Lists at = node_elements(m);
   std::size_t swaps = 0;
   for (int round = 0; round < rounds; ++round) {
-    std::vector<std::pair<double, std::uint32_t>> scores;
-    for (std::uint32_t q = 0; q < m.elements.size(); ++q) {
+    // The quads' scores on the threads, listed in element order.
+    const auto ne = static_cast<std::ptrdiff_t>(m.elements.size());
+    std::vector<double> score(m.elements.size());
+#pragma omp parallel for schedule(static) if (ne > 16384)
+    for (std::ptrdiff_t i = 0; i < ne; ++i) {
+      const auto q = static_cast<std::size_t>(i);
       if (!m.alive[q] || !m.is_quad(q)) continue;
       const auto& n = m.normal[q];
-      scores.push_back({smoothing_score(m.coords, m.elements[q], n, std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2])), q});
+      score[q] = smoothing_score(m.coords, m.elements[q], n, std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]));
     }
+    std::vector<std::pair<double, std::uint32_t>> scores;
+    for (std::uint32_t q = 0; q < m.elements.size(); ++q)
+      if (m.alive[q] && m.is_quad(q)) scores.push_back({score[q], q});
     const auto worst = std::min(scores.size(), std::max<std::size_t>(16, static_cast<std::size_t>(share * static_cast<double>(scores.size()))));
     std::partial_sort(scores.begin(), scores.begin() + static_cast<std::ptrdiff_t>(worst), scores.end());
     std::size_t made = 0;

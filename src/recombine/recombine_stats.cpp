@@ -30,6 +30,20 @@ double efficiency_index(const std::vector<double>& lengths) {
 
 void compute_statistics(const MixedMesh& m, const SizeFunction& size_field, RecombineStats& stats) {
   stats.quads = stats.triangles = stats.invalid_quads = 0;
+  // eta and validity of the quads on the threads; summed below in element order, so that
+  // eta_mean does not depend on the thread count.
+  const auto ne = static_cast<std::ptrdiff_t>(m.elements.size());
+  std::vector<double> quad_eta_of(m.elements.size(), 0.0);
+  std::vector<char> quad_invalid(m.elements.size(), 0);
+#pragma omp parallel for schedule(static) if (ne > 16384)
+  for (std::ptrdiff_t i = 0; i < ne; ++i) {
+    const auto e = static_cast<std::size_t>(i);
+    const auto& el = m.elements[e];
+    if (!m.alive[e] || MixedMesh::size(el) != 4) continue;
+    const QuadCorners x{m.point(el[0]), m.point(el[1]), m.point(el[2]), m.point(el[3])};
+    quad_eta_of[e] = quad_eta(x, m.normal[e]).eta;
+    quad_invalid[e] = quad_min_corner_sine(x, m.normal[e]) <= 0;
+  }
   double eta_sum = 0, eta_min = 1;
   std::vector<std::uint32_t> degree(m.num_nodes(), 0);
   std::vector<std::array<NodeIndex, 2>> edges;
@@ -46,11 +60,9 @@ void compute_statistics(const MixedMesh& m, const SizeFunction& size_field, Reco
       continue;
     }
     ++stats.quads;
-    const QuadCorners x{m.point(el[0]), m.point(el[1]), m.point(el[2]), m.point(el[3])};
-    const double eta = quad_eta(x, m.normal[e]).eta;
-    eta_sum += eta;
-    eta_min = std::min(eta_min, eta);
-    if (quad_min_corner_sine(x, m.normal[e]) <= 0) ++stats.invalid_quads;
+    eta_sum += quad_eta_of[e];
+    eta_min = std::min(eta_min, quad_eta_of[e]);
+    stats.invalid_quads += quad_invalid[e];
   }
   stats.eta_min = stats.quads > 0 ? eta_min : 0.0;
   stats.eta_mean = stats.quads > 0 ? eta_sum / static_cast<double>(stats.quads) : 0.0;
