@@ -217,7 +217,9 @@ class MshWriter {
         }
         // The first group keeps the element's tags; copies for further groups get fresh ones.
         const Tag fresh = next_tag;
-        const auto tag_of = [&](std::size_t e) { return int_tag(p == 0 ? block.tags[e] : fresh + e, "element"); };
+        const auto tag_of = [&](std::size_t e) {
+          return int_tag(p == 0 ? block.tags[e] : fresh + e, "element");
+        };
         if (p > 0) next_tag += block.size();
         if (!binary_) {
           out_.records(block.size(), [&](OutBuffer& o, std::size_t e) {

@@ -105,10 +105,9 @@ class OutBuffer {
           failures[static_cast<std::size_t>(p)] = std::current_exception();
         }
       }
-      for (int p = 0; p < used; ++p) {
-        if (failures[static_cast<std::size_t>(p)]) std::rethrow_exception(failures[static_cast<std::size_t>(p)]);
-        const auto& b = pieces[static_cast<std::size_t>(p)].buf_;
-        append(b.data(), b.data() + b.size());
+      for (std::size_t p = 0; p < static_cast<std::size_t>(used); ++p) {
+        if (failures[p]) std::rethrow_exception(failures[p]);
+        append(pieces[p].buf_.data(), pieces[p].buf_.data() + pieces[p].buf_.size());
       }
     }
   }

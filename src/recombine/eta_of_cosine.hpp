@@ -12,7 +12,8 @@
 // c -> 1). asin s = s + s^3 Q(s^2), Q the Taylor series of degree 70 economised to degree
 // 11 in Chebyshev polynomials on z = s^2 in [0, 1/4] (exact rational arithmetic; the
 // dropped terms sum to 1.4e-15 Q(0), which the factor s^2 Q <= 0.05 makes 7e-17 of asin).
-// Tested against std::asin on a dense sweep (tests/recombine/quad_quality_test.cpp).
+// Within 2.5e-16 of 1 - asinl(c) / (pi / 2) on a dense sweep, and never increasing
+// (tests/recombine/quad_quality_test.cpp).
 
 #include <cmath>
 

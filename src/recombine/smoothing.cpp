@@ -255,7 +255,8 @@ class Smoother {
   bool try_move(NodeIndex v, bool raise_mean, double global_min, std::vector<double>& trial);
   // The scores of the star entries [first, last) into trial[0 ..): quads four at a time
   // (smoothing_scores4: the same values; random quads 59-73 -> 43-48 ns each, before eta
-  // too went into lanes), triangles by element_score. The move's test then reads them in star order.
+  // too went into lanes), triangles by element_score. The move's test then reads them in
+  // star order.
   void score_star(std::uint32_t first, std::uint32_t last, std::vector<double>& trial) const {
     trial.resize(last - first);
     const std::array<NodeIndex, 4>* quads[4];
