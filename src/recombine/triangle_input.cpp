@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <map>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -229,21 +229,21 @@ void make_regions_even(TriangleSurface& s) {
 
   std::optional<TriangleTopology> built;
   const TriangleTopology& topo = topology_of(s, built);
-  // Longest boundary edge per odd region.
+  // Longest boundary edge per odd region, preferring edges whose end nodes have 3 or more
+  // triangles: at a node with two, the halves' neighbours could only form a quad with a flat
+  // (180-degree) corner there. (Ranked by the pair, roomy first: a length added to a large
+  // bonus was absorbed by it, which made the first roomy edge win, not the longest.)
   std::vector<std::uint32_t> best_edge(num_regions, kNoTriangle);
-  std::vector<double> best_length(num_regions, -1.0);
+  std::vector<std::pair<bool, double>> best_rank(num_regions, {false, -1.0});
   for (std::uint32_t e : topo.boundary_edges) {
     const std::uint32_t t = topo.edge_triangles[topo.edge_triangle_offsets[e]];
     const auto r = static_cast<std::size_t>(s.region[t]);
     if (count[r] % 2 == 0) continue;
-    // Prefer edges whose end nodes have 3 or more triangles: at a node with two, the halves'
-    // neighbours could only form a quad with a flat (180-degree) corner there.
     const bool roomy = topo.vertex_triangles[topo.edges[e][0]] >= 3 &&
                        topo.vertex_triangles[topo.edges[e][1]] >= 3;
-    const double len = squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1]) +
-                       (roomy ? 1e300 * 0 + std::numeric_limits<double>::max() / 4 : 0.0);
-    if (len > best_length[r]) {
-      best_length[r] = len;
+    const std::pair<bool, double> rank{roomy, squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1])};
+    if (rank > best_rank[r]) {
+      best_rank[r] = rank;
       best_edge[r] = e;
     }
   }

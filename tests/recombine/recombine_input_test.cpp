@@ -1,6 +1,12 @@
 // Bad or unusual input: clear InputError messages, or the documented result.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <map>
+#include <vector>
+
 #include "quadval/error.hpp"
 #include "quadval/recombine.hpp"
 #include "recombine/quad_mesh_checks.hpp"
@@ -100,6 +106,22 @@ TEST(RecombineInput, OddCountSplitsTheLongestBoundaryEdge) {
     // One boundary edge is now two: the boundary has one more edge, same total length.
     const auto before = test::boundary_edges(in), after = test::boundary_edges(r.mesh);
     EXPECT_EQ(after.size(), before.size() + 1);
+    // The split edge, the one the output lacks, is the longest of those whose two nodes are
+    // in 3 or more triangles (make_regions_even's preference).
+    std::vector<test::TagEdge> gone;
+    std::set_difference(before.begin(), before.end(), after.begin(), after.end(), std::back_inserter(gone));
+    ASSERT_EQ(gone.size(), 1u);
+    std::map<Tag, std::size_t> index, triangles_at;
+    for (std::size_t v = 0; v < in.num_nodes(); ++v) index[in.node_tags[v]] = v;
+    for (NodeIndex v : in.blocks[0].nodes) ++triangles_at[in.node_tags[v]];
+    const auto length = [&](const test::TagEdge& e) {
+      const auto a = in.node(static_cast<NodeIndex>(index[e.first])), b = in.node(static_cast<NodeIndex>(index[e.second]));
+      return std::hypot(a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    };
+    double longest = 0;
+    for (const test::TagEdge& e : before)
+      if (triangles_at[e.first] >= 3 && triangles_at[e.second] >= 3) longest = std::max(longest, length(e));
+    EXPECT_EQ(length(gone[0]), longest);
   }
 }
 
