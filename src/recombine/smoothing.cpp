@@ -557,9 +557,7 @@ std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,
   std::vector<int> level_of(m.num_nodes(), -1);
   std::vector<std::vector<NodeIndex>> levels;
   for (NodeIndex v : nodes) {
-    const bool sliding =
-        fixed[v] && options.slides != nullptr && (*options.slides)[v][0] != kNoNode;
-    if ((fixed[v] && !sliding) || at[v].empty()) continue;
+    if ((fixed[v] && !can_slide(v, fixed, options)) || at[v].empty()) continue;
     int level = 0;
     for (std::uint32_t e : at[v])
       for (int c = 0; c < MixedMesh::size(m.elements[e]); ++c)
