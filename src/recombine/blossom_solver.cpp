@@ -119,6 +119,20 @@ class Solver {
   }
 
  private:
+  // Empties a list whose id will be reused, keeping its memory unless it is large. On
+  // uniform meshes, freeing and growing again the lists of the groups and blossoms that
+  // shrinks and expands make and drop took a tenth of the solver's time in malloc and free
+  // (perf); uniform-100k-a6's matching 6.5 -> 5.4 s (medians of 5 alternating runs),
+  // square-hole-1M 9.0 -> 8.7 s (within the noise), the same matching.
+  template <class T>
+  static void recycle(std::vector<T>& list) {
+    constexpr std::size_t kKeep = 256;
+    if (list.capacity() > kKeep)
+      std::vector<T>().swap(list);
+    else
+      list.clear();
+  }
+
   // --- Graph ---
   std::uint32_t vertex(std::int32_t p) const {
     const CostEdge& e = edges_[static_cast<std::uint32_t>(p) >> 1];
@@ -149,7 +163,7 @@ class Solver {
         slot_[v].group = g;
         listed_in_[v] = kNoTree;  // its old group's list is dropped (and the id reused)
       });
-      std::vector<std::uint32_t>().swap(boundary_[gc]);
+      recycle(boundary_[gc]);
       free_groups_.push_back(gc);
     }
     if (!is_blossom(big) && crosses(big)) list_boundary(big, g);
@@ -657,10 +671,13 @@ class Solver {
   void expand(std::uint32_t b) {
     settle(b);
     QV_ASSERT(z_[b] == 0, "expanding a blossom with z = " << z_[b]);
-    std::vector<std::uint32_t> children = std::move(kids(b));
-    std::vector<std::int32_t> links = std::move(ends(b));
-    kids(b).clear();
-    ends(b).clear();
+    // Copied out, so that b's own lists keep their memory for the next blossom with its id.
+    std::vector<std::uint32_t>& children = expanded_children_;
+    std::vector<std::int32_t>& links = expanded_links_;
+    children.assign(kids(b).begin(), kids(b).end());
+    links.assign(ends(b).begin(), ends(b).end());
+    recycle(kids(b));
+    recycle(ends(b));
     for (std::uint32_t c : children) slot_[c].parent = kNone;
     split_groups(b, children);
     const std::int32_t k = static_cast<std::int32_t>(children.size());
@@ -818,6 +835,8 @@ class Solver {
   std::vector<std::vector<std::uint32_t>> boundary_;  // per group (blossom groups only)
   std::vector<std::uint32_t> listed_in_;              // per vertex: the group listing it
   std::vector<std::pair<std::uint32_t, std::uint32_t>> work_;
+  std::vector<std::uint32_t> expanded_children_;  // expand's copy of the blossom's cycle
+  std::vector<std::int32_t> expanded_links_;
   std::uint32_t stamp_ = 0;
   std::int64_t eps_ = 0;
   EventQueue grow_queue_, shrink_queue_, expand_queue_;
