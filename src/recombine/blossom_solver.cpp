@@ -138,6 +138,12 @@ class Solver {
     const CostEdge& e = edges_[static_cast<std::uint32_t>(p) >> 1];
     return (p & 1) ? e.v : e.u;
   }
+  // v's mate is the vertex of endpoint p (partner = vertex(p), when the caller knows it).
+  void set_mate(std::uint32_t v, std::int32_t p, std::uint32_t partner) {
+    slot_[v].mate = p;
+    slot_[v].mate_vertex = partner;
+  }
+  void set_mate(std::uint32_t v, std::int32_t p) { set_mate(v, p, vertex(p)); }
   static std::int32_t endpoint(std::uint32_t e, std::uint32_t from_vertex, const CostEdge& ce) {
     return static_cast<std::int32_t>(2 * e + (ce.u == from_vertex ? 0 : 1));
   }
@@ -355,8 +361,8 @@ class Solver {
       const std::uint32_t w = ce.u == v ? ce.v : ce.u;
       if (slot_[w].mate == kNone) {
         slot_[v].y += best;
-        slot_[v].mate = endpoint(best_edge, w, ce);
-        slot_[w].mate = endpoint(best_edge, v, ce);
+        set_mate(v, endpoint(best_edge, w, ce), w);
+        set_mate(w, endpoint(best_edge, v, ce), v);
       } else {
         // Raised to its tightest edge, v may reach a free vertex by a tight path of three
         // edges v-w=x-z (w=x matched): swap that pair. Otherwise v's dual stays put, so
@@ -381,15 +387,15 @@ class Solver {
       if (!tight(e1)) continue;
       const std::uint32_t w = other_end(e1, v);
       if (slot_[w].mate == kNone) continue;
-      const std::uint32_t x = vertex(slot_[w].mate);
+      const std::uint32_t x = slot_[w].mate_vertex;
       for (std::uint32_t k = offsets_[x]; k < offsets_[x + 1]; ++k) {
         const std::uint32_t e2 = incident_[k].edge;
         const std::uint32_t z = other_end(e2, x);
         if (z == v || slot_[z].mate != kNone || !tight(e2)) continue;
-        slot_[v].mate = endpoint(e1, w, edges_[e1]);
-        slot_[w].mate = endpoint(e1, v, edges_[e1]);
-        slot_[x].mate = endpoint(e2, z, edges_[e2]);
-        slot_[z].mate = endpoint(e2, x, edges_[e2]);
+        set_mate(v, endpoint(e1, w, edges_[e1]), w);
+        set_mate(w, endpoint(e1, v, edges_[e1]), v);
+        set_mate(x, endpoint(e2, z, edges_[e2]), z);
+        set_mate(z, endpoint(e2, x, edges_[e2]), x);
         return true;
       }
     }
@@ -440,9 +446,9 @@ class Solver {
   void assign_minus(std::uint32_t b, std::int32_t p, std::uint32_t t) {
     enter_tree(b, kMinus, p, t);
     if (is_blossom(b)) expand_queue_.push(eps_ + z_[b] / 2, b, eps_);
-    const std::int32_t q = slot_[slot_[b].base].mate;
-    QV_ASSERT(q != kNone, "a '-' node without a mate");
-    assign_plus(outer(vertex(q)), q ^ 1, t);
+    const Slot& base = slot_[slot_[b].base];
+    QV_ASSERT(base.mate != kNone, "a '-' node without a mate");
+    assign_plus(outer(base.mate_vertex), base.mate ^ 1, t);
   }
 
   // Drops stale entries from the top of each queue (their key no longer matches the state).
@@ -729,7 +735,7 @@ class Solver {
       while (true) {
         const std::uint32_t bs = outer(s);
         if (is_blossom(bs)) augment_blossom(bs, s);
-        slot_[s].mate = p;
+        set_mate(s, p);
         if (slot_[bs].label != kPlus || slot_[bs].labelend == kNone) break;
         const std::uint32_t t = vertex(slot_[bs].labelend);
         const std::uint32_t bt = outer(t);
@@ -737,7 +743,7 @@ class Solver {
         s = vertex(slot_[bt].labelend);
         const std::uint32_t jv = vertex(slot_[bt].labelend ^ 1);
         if (is_blossom(bt)) augment_blossom(bt, jv);
-        slot_[jv].mate = slot_[bt].labelend;
+        set_mate(jv, slot_[bt].labelend);
         p = slot_[bt].labelend ^ 1;
       }
     }
@@ -789,8 +795,8 @@ class Solver {
       j += jstep;
       c = cycle[at(j)];
       if (is_blossom(c)) work_.push_back({c, vertex(p ^ 1)});
-      slot_[vertex(p)].mate = p ^ 1;
-      slot_[vertex(p ^ 1)].mate = p;
+      set_mate(vertex(p), p ^ 1);
+      set_mate(vertex(p ^ 1), p);
     }
     std::rotate(cycle.begin(), cycle.begin() + i, cycle.end());
     std::rotate(links.begin(), links.begin() + i, links.end());
@@ -828,10 +834,12 @@ class Solver {
     std::uint32_t tree = kNoTree;   // node: its tree, or kNoTree
     Label label = kFree;            // node
     std::int32_t mate = kNone;      // vertex: endpoint at the partner, or kNone
+    std::uint32_t mate_vertex = 0;  // vertex: the partner (vertex(mate)), where mate != kNone
     std::int32_t labelend = kNone;  // node: endpoint in the parent through which it was reached
     std::int32_t parent = kNone;    // node: the blossom containing it, or kNone
     std::uint32_t base = 0;         // node: its base vertex
   };
+  static_assert(sizeof(Slot) == 64, "one cache line per record");
   std::vector<Slot> slot_;
   std::uint32_t num_groups_ = 0, num_nodes_ = 0;
   std::vector<std::uint32_t> free_groups_;
