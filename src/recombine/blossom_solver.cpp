@@ -73,8 +73,8 @@ class Solver {
     incident_.resize(offsets_[n]);
     std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
     for (std::uint32_t e = 0; e < edges.size(); ++e) {
-      incident_[fill[edges[e].u]++] = {e, edges[e].v};
-      incident_[fill[edges[e].v]++] = {e, edges[e].u};
+      incident_[fill[edges[e].u]++] = {static_cast<std::int32_t>(2 * e), edges[e].v};
+      incident_[fill[edges[e].v]++] = {static_cast<std::int32_t>(2 * e + 1), edges[e].u};
     }
     slot_.resize(n);
     num_groups_ = num_nodes_ = n;
@@ -335,9 +335,9 @@ class Solver {
   bool greedy_init(const std::vector<std::uint32_t>& visit) {
     for (std::uint32_t v = 0; v < n_; ++v) {
       if (offsets_[v] == offsets_[v + 1]) return false;  // isolated: no perfect matching
-      std::int64_t lo = edges_[incident_[offsets_[v]].edge].cost;
+      std::int64_t lo = edges_[incident_[offsets_[v]].edge()].cost;
       for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i)
-        lo = std::min(lo, edges_[incident_[i].edge].cost);
+        lo = std::min(lo, edges_[incident_[i].edge()].cost);
       slot_[v].y = lo / 2;
     }
     for (std::uint32_t v : visit) {
@@ -346,7 +346,7 @@ class Solver {
       std::uint32_t best_edge = 0;
       bool found = false;
       for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i) {
-        const std::uint32_t e = incident_[i].edge;
+        const std::uint32_t e = incident_[i].edge();
         const CostEdge& ce = edges_[e];
         const std::int64_t s = edges_[e].cost - slot_[ce.u].y - slot_[ce.v].y;
         // The smallest slack sets how far y_v can rise; among equals prefer a free end.
@@ -383,13 +383,13 @@ class Solver {
       return edges_[e].cost == slot_[edges_[e].u].y + slot_[edges_[e].v].y;
     };
     for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i) {
-      const std::uint32_t e1 = incident_[i].edge;
+      const std::uint32_t e1 = incident_[i].edge();
       if (!tight(e1)) continue;
       const std::uint32_t w = other_end(e1, v);
       if (slot_[w].mate == kNone) continue;
       const std::uint32_t x = slot_[w].mate_vertex;
       for (std::uint32_t k = offsets_[x]; k < offsets_[x + 1]; ++k) {
-        const std::uint32_t e2 = incident_[k].edge;
+        const std::uint32_t e2 = incident_[k].edge();
         const std::uint32_t z = other_end(e2, x);
         if (z == v || slot_[z].mate != kNone || !tight(e2)) continue;
         set_mate(v, endpoint(e1, w, edges_[e1]), w);
@@ -406,13 +406,14 @@ class Solver {
   // Queues the edges from vertex v of the "+" node b to other "+" nodes and to free nodes.
   void push_edges_of_plus_vertex(std::uint32_t v, std::uint32_t b) {
     for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i) {
-      const auto [e, w] = incident_[i];
+      const Incidence in = incident_[i];
+      const std::uint32_t e = in.edge(), w = in.other;
       const std::uint32_t other = outer(w);
       if (other == b) continue;
       if (slot_[other].label == kPlus)
-        shrink_queue_.push(2 * eps_ + slack(e, v, b, w, other), e, 2 * eps_);
+        shrink_queue_.push(2 * eps_ + slack(e, v, b, w, other), e, 2 * eps_, in.u(v), in.v(v));
       else if (slot_[other].label == kFree)
-        grow_queue_.push(eps_ + slack(e, v, b, w, other), e, eps_);
+        grow_queue_.push(eps_ + slack(e, v, b, w, other), e, eps_, in.u(v), in.v(v));
       else if (slot_[other].tree != slot_[b].tree)
         parked_[slot_[other].tree].push_back(e);
     }
@@ -424,9 +425,11 @@ class Solver {
   void push_edges_to_plus(std::uint32_t b) {
     for_boundary(b, [&](std::uint32_t v) {
       for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i) {
-        const auto [e, w] = incident_[i];
+        const Incidence in = incident_[i];
+        const std::uint32_t e = in.edge(), w = in.other;
         const std::uint32_t other = outer(w);
-        if (slot_[other].label == kPlus) grow_queue_.push(eps_ + slack(e, v, b, w, other), e, eps_);
+        if (slot_[other].label == kPlus)
+          grow_queue_.push(eps_ + slack(e, v, b, w, other), e, eps_, in.u(v), in.v(v));
       }
     });
   }
@@ -455,14 +458,13 @@ class Solver {
   void clean_grow() {
     while (!grow_queue_.empty()) {
       const EventQueue::Event ev = grow_queue_.top();
-      const CostEdge& ce = edges_[ev.id];
-      const std::uint32_t a = outer(ce.u), b = outer(ce.v);
+      const std::uint32_t a = outer(ev.u), b = outer(ev.v);
       const Label la = slot_[a].label, lb = slot_[b].label;
       if (a != b && ((la == kPlus && lb == kFree) || (la == kFree && lb == kPlus))) {
-        const std::int64_t key = eps_ + slack(ev.id);
+        const std::int64_t key = eps_ + slack(ev.id, ev.u, a, ev.v, b);
         if (key == ev.key) return;
         grow_queue_.pop();
-        grow_queue_.push(key, ev.id, eps_);
+        grow_queue_.push(key, ev.id, eps_, ev.u, ev.v);
         continue;
       }
       grow_queue_.pop();
@@ -472,16 +474,15 @@ class Solver {
   void clean_shrink() {
     while (!shrink_queue_.empty()) {
       const EventQueue::Event ev = shrink_queue_.top();
-      const CostEdge& ce = edges_[ev.id];
-      const std::uint32_t a = outer(ce.u), b = outer(ce.v);
+      const std::uint32_t a = outer(ev.u), b = outer(ev.v);
       if (a != b && slot_[a].label == kPlus && slot_[b].label == kPlus &&
-          2 * eps_ + slack(ev.id) == ev.key)
+          2 * eps_ + slack(ev.id, ev.u, a, ev.v, b) == ev.key)
         return;
       shrink_queue_.pop();
       if (a == b) continue;
       const Label la = slot_[a].label, lb = slot_[b].label;
       if ((la == kPlus && lb == kFree) || (la == kFree && lb == kPlus))
-        grow_queue_.push(eps_ + slack(ev.id), ev.id, eps_);
+        grow_queue_.push(eps_ + slack(ev.id, ev.u, a, ev.v, b), ev.id, eps_, ev.u, ev.v);
       else
         park(a, b, ev.id);
     }
@@ -535,10 +536,11 @@ class Solver {
       // At equal keys, "+"-"+" events (augment, shrink) go first: growing a tree further
       // through tight edges when it already touches another tree only makes it bigger.
       if (t == t_shrink) {
-        const std::uint32_t e = shrink_queue_.top().id;
+        const EventQueue::Event ev = shrink_queue_.top();
         shrink_queue_.pop();
-        const std::uint32_t ta = slot_[outer(edges_[e].u)].tree;
-        const std::uint32_t tb = slot_[outer(edges_[e].v)].tree;
+        const std::uint32_t e = ev.id;
+        const std::uint32_t ta = slot_[outer(ev.u)].tree;
+        const std::uint32_t tb = slot_[outer(ev.v)].tree;
         if (ta == tb) {
           shrink(static_cast<std::int32_t>(2 * e));
         } else {
@@ -547,12 +549,12 @@ class Solver {
           if (progress_) progress_(free_at_start_ - alive_trees_, free_at_start_);
         }
       } else if (t == t_grow) {
-        const std::uint32_t e = grow_queue_.top().id;
+        const EventQueue::Event ev = grow_queue_.top();
         grow_queue_.pop();
-        const CostEdge& ce = edges_[e];
-        const bool u_plus = slot_[outer(ce.u)].label == kPlus;
-        const std::uint32_t in = u_plus ? ce.u : ce.v, out = u_plus ? ce.v : ce.u;
-        const std::int32_t p = endpoint(e, in, ce);  // vertex(p) = in, vertex(p ^ 1) = out
+        const bool u_plus = slot_[outer(ev.u)].label == kPlus;
+        const std::uint32_t in = u_plus ? ev.u : ev.v, out = u_plus ? ev.v : ev.u;
+        // vertex(p) = in, vertex(p ^ 1) = out (ev.u is the edge's u)
+        const std::int32_t p = static_cast<std::int32_t>(2 * ev.id + (u_plus ? 0 : 1));
         const std::uint32_t w = outer(out);
         assign_minus(w, p, slot_[outer(in)].tree);
       } else {
@@ -585,7 +587,7 @@ class Solver {
         const std::uint32_t a = outer(edges_[e].u), b = outer(edges_[e].v);
         const Label la = slot_[a].label, lb = slot_[b].label;
         if ((la == kPlus && lb == kFree) || (la == kFree && lb == kPlus))
-          grow_queue_.push(eps_ + slack(e), e, eps_);
+          grow_queue_.push(eps_ + slack(e), e, eps_, edges_[e].u, edges_[e].v);
       }
       std::vector<std::uint32_t>().swap(parked_[t]);
     }
@@ -810,9 +812,15 @@ class Solver {
   // Per vertex v, its edges [offsets_[v], offsets_[v + 1]) with their far ends beside them:
   // growing a tree then reaches the far end's record without loading the edge first (one
   // dependent load fewer: uniform-100k-a6's matching 6.2 -> 5.6 s, medians of 7 alternating
-  // runs; square-hole-100k and -1M within the noise).
+  // runs; square-hole-100k and -1M within the noise), and the events it queues carry the
+  // edge's ends (event_queue.hpp).
   struct Incidence {
-    std::uint32_t edge, other;
+    std::int32_t end;     // the edge's endpoint at this vertex (vertex(end) is the vertex)
+    std::uint32_t other;  // the edge's other vertex
+    std::uint32_t edge() const { return static_cast<std::uint32_t>(end) >> 1; }
+    // The edge's u and v (CostEdge), given the vertex whose incidence this is.
+    std::uint32_t u(std::uint32_t self) const { return (end & 1) ? other : self; }
+    std::uint32_t v(std::uint32_t self) const { return (end & 1) ? self : other; }
   };
   std::vector<std::uint32_t> offsets_;
   std::vector<Incidence> incident_;

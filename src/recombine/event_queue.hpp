@@ -7,16 +7,21 @@
 // that of one heap: an event in the heap with the lane's key was queued before the dual value
 // reached it, so before every event in the lane.
 //
-// The heap is 4-ary, of 16-byte entries (a 32-bit queue order): half the levels of a binary
-// heap, and the four children of an entry are 64 contiguous bytes (one or two cache lines,
-// where a binary heap takes one per level). On square-hole-1M, whose grow heap holds 284k
-// entries on average (450k at most), pops took a fifth of the solver's time in a binary heap
-// of 24-byte entries. Counted by cachegrind (the same run every time, where wall times on
-// this machine vary by 20%), the solver on square-hole-1M: L1 data misses 268M -> 220M,
-// instructions 10.5G -> 11.4G. Radix heaps (keys are integers that never fall below the last
-// popped) did no better: by bit, 12.1G instructions (keys span about 2^31, so an entry moves
-// down up to 31 times); by byte, 10.8G instructions, 200M L1 misses but 11% more last-level
-// misses.
+// The heap is 4-ary: half the levels of a binary heap, and the four children of an entry are
+// contiguous (two cache lines, where a binary heap takes one per level). On square-hole-1M,
+// whose grow heap holds 284k entries on average (450k at most), pops took a fifth of the
+// solver's time in a binary heap. Counted by cachegrind (the same run every time, where wall
+// times on this machine vary by 20%), the solver on square-hole-1M with 16-byte entries:
+// L1 data misses 268M -> 220M, instructions 10.5G -> 11.4G. Radix heaps (keys are integers
+// that never fall below the last popped) did no better: by bit, 12.1G instructions (keys span
+// about 2^31, so an entry moves down up to 31 times); by byte, 10.8G instructions, 200M L1
+// misses but 11% more last-level misses.
+//
+// The entries have since grown to 24 bytes with the edge's two ends, which the solver reads
+// first when an event surfaces: loading the edge record for them was a cache miss (a fifth
+// of the solver's time, perf), where the heap's top entries are in cache. square-hole-1M's
+// matching 7.8 -> 6.8 s (medians of 5 alternating runs, twice), square-hole-100k 0.39 ->
+// 0.35 s, uniform-100k within the noise.
 
 #include <algorithm>
 #include <cstdint>
@@ -31,7 +36,8 @@ class EventQueue {
   struct Event {
     std::int64_t key;
     std::uint32_t id;
-    std::uint32_t seq;  ///< queue order, the tie-break among equal keys
+    std::uint32_t seq;   ///< queue order, the tie-break among equal keys
+    std::uint32_t u, v;  ///< the caller's: an edge event's two ends (the solver's edges are 24 MB on 1M triangles)
   };
 
   /// @param last_seq  the queue orders run 0..last_seq before the heap is renumbered (tests
@@ -39,11 +45,11 @@ class EventQueue {
   explicit EventQueue(std::uint32_t last_seq = std::numeric_limits<std::uint32_t>::max())
       : last_seq_(last_seq) {}
 
-  /// Queues (key, id); key == now puts it in the lane, so keys queued later must not be below
-  /// now (the solver's dual value only rises).
-  void push(std::int64_t key, std::uint32_t id, std::int64_t now) {
+  /// Queues (key, id) with the caller's u and v; key == now puts it in the lane, so keys
+  /// queued later must not be below now (the solver's dual value only rises).
+  void push(std::int64_t key, std::uint32_t id, std::int64_t now, std::uint32_t u = 0, std::uint32_t v = 0) {
     if (seq_ >= last_seq_) renumber();
-    const Event ev{key, id, seq_++};
+    const Event ev{key, id, seq_++, u, v};
     if (key == now)
       due_.push_back(ev);
     else
