@@ -114,15 +114,24 @@
 //   uniform-100k 1,364 instead of 1,384 vertices free at the start, 2.8 s instead of 2.6 s.
 //   Most optimal pairs are not tight at those duals; what the solver spends its time on is
 //   finding the duals, not the pairs.
-// Nor did prefetching the records of queued grow events and of dissolving nodes, or keeping
-// each edge's far end and cost beside the vertex, gain beyond the noise (memory-bound, but
-// the loads of one step depend on each other); nor, on square-hole-1M (solver alone, medians
+// Nor did prefetching the records of queued grow events and of dissolving nodes gain beyond
+// the noise (memory-bound, but the loads of one step depend on each other; re-tried on the
+// FIFO lane and the heap's next entries: square-hole-100k 10% faster, square-hole-1M and
+// uniform-100k not); nor, on square-hole-1M (solver alone, medians
 // of 6-8 alternating runs), transparent huge pages for the per-vertex arrays (madvise; the
 // kernel's zeroing of 2 MiB pages took back what the TLB gained) or reserving room for the
 // blossoms in the per-node arrays up front. Where its grow queue's 8.9M pops go there: 5.0M
 // events fire, 2.5M are stale because their "+" end's tree dissolved, 1.1M because their free
 // end joined a tree by another edge, 0.3M are queued again; queues per tree, dropped whole
 // when the tree dissolves, would spare at most the first kind (about a tenth of the time).
+// What did gain was removing loads from those dependent chains: each vertex's far ends
+// beside its edge ids, its partner beside its mate endpoint, the edge's two ends in the
+// queued events (square-hole-1M's matching 7.8 -> 6.8 s), and no malloc/free of the lists
+// of reused blossom and group ids; the .cpp and event_queue.hpp give the figures.
+// Where the time goes since (perf annotate of grow_trees): on square-hole-1M a fifth in the
+// grow heap's sift-down (its lower levels, megabytes of 24-byte entries, miss the caches);
+// on uniform-100k-a6 a fifth in the walk over a dissolving tree's nodes (a miss per node),
+// which a tree marked dead, its nodes freed when next met, would spare.
 
 #include <cstdint>
 #include <functional>
