@@ -974,6 +974,8 @@ class ProgressSum {
 bool min_cost_perfect_matching(std::uint32_t num_nodes, std::span<const CostEdge> edges,
                                std::vector<char>& matched, const MatchingProgress& progress) {
   // Checked here, in the caller's numbering (the solver sees the renumbered graph).
+  QV_ASSERT(edges.size() < (std::size_t{1} << 30),
+            edges.size() << " edges: the endpoints 2e + 1 must fit 32 bits");
   for (std::size_t e = 0; e < edges.size(); ++e)
     QV_ASSERT(edges[e].u < num_nodes && edges[e].v < num_nodes && edges[e].u != edges[e].v,
               "edge " << e << " (" << edges[e].u << ", " << edges[e].v << ") in a graph of "
