@@ -114,6 +114,9 @@
 //   uniform-100k 1,364 instead of 1,384 vertices free at the start, 2.8 s instead of 2.6 s.
 //   Most optimal pairs are not tight at those duals; what the solver spends its time on is
 //   finding the duals, not the pairs.
+// - A larger start on the tight edges: the greedy start already leaves as few vertices free
+//   as a maximum matching of the edges tight at its duals would (LEMON's MaxMatching on
+//   them: uniform-100k-a6 1,504 free either way, square-hole-100k 14,948).
 // Nor did prefetching the records of queued grow events and of dissolving nodes gain beyond
 // the noise (memory-bound, but the loads of one step depend on each other; re-tried on the
 // FIFO lane and the heap's next entries: square-hole-100k 10% faster, square-hole-1M and
