@@ -222,9 +222,6 @@ class Solver {
   // Boundary lists: each group lists (at least) its vertices with an edge leaving the group, so
   // that queueing a big blossom's edges costs its boundary, not its size. Entries that stopped
   // qualifying are dropped when the list is next walked.
-  std::uint32_t other_end(std::uint32_t e, std::uint32_t v) const {
-    return edges_[e].u == v ? edges_[e].v : edges_[e].u;
-  }
   bool crosses(std::uint32_t v) const {
     for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i)
       if (slot_[incident_[i].other].group != slot_[v].group) return true;
@@ -261,11 +258,8 @@ class Solver {
     if (slot_[b].label == kMinus) return slot_[b].join - eps_;
     return 0;
   }
-  std::int64_t slack(std::uint32_t e) const {
-    const CostEdge& ce = edges_[e];
-    return edges_[e].cost - dual(ce.u) - dual(ce.v) - lazy(outer(ce.u)) - lazy(outer(ce.v));
-  }
-  // slack(e) for e = (v, w), whose outer nodes are known: b = outer(v), other = outer(w).
+  // The slack of edge e = (v, w), whose outer nodes b = outer(v) and other = outer(w) the
+  // caller has found already.
   std::int64_t slack(std::uint32_t e, std::uint32_t v, std::uint32_t b, std::uint32_t w,
                      std::uint32_t other) const {
     return edges_[e].cost - dual(v) - dual(w) - lazy(b) - lazy(other);
@@ -383,14 +377,12 @@ class Solver {
       return edges_[e].cost == slot_[edges_[e].u].y + slot_[edges_[e].v].y;
     };
     for (std::uint32_t i = offsets_[v]; i < offsets_[v + 1]; ++i) {
-      const std::uint32_t e1 = incident_[i].edge();
+      const std::uint32_t e1 = incident_[i].edge(), w = incident_[i].other;
       if (!tight(e1)) continue;
-      const std::uint32_t w = other_end(e1, v);
       if (slot_[w].mate == kNone) continue;
       const std::uint32_t x = slot_[w].mate_vertex;
       for (std::uint32_t k = offsets_[x]; k < offsets_[x + 1]; ++k) {
-        const std::uint32_t e2 = incident_[k].edge();
-        const std::uint32_t z = other_end(e2, x);
+        const std::uint32_t e2 = incident_[k].edge(), z = incident_[k].other;
         if (z == v || slot_[z].mate != kNone || !tight(e2)) continue;
         set_mate(v, endpoint(e1, w, edges_[e1]), w);
         set_mate(w, endpoint(e1, v, edges_[e1]), v);
@@ -584,10 +576,11 @@ class Solver {
     }
     for (std::uint32_t t : {ta, tb}) {
       for (std::uint32_t e : parked_[t]) {
-        const std::uint32_t a = outer(edges_[e].u), b = outer(edges_[e].v);
+        const CostEdge& ce = edges_[e];
+        const std::uint32_t a = outer(ce.u), b = outer(ce.v);
         const Label la = slot_[a].label, lb = slot_[b].label;
         if ((la == kPlus && lb == kFree) || (la == kFree && lb == kPlus))
-          grow_queue_.push(eps_ + slack(e), e, eps_, edges_[e].u, edges_[e].v);
+          grow_queue_.push(eps_ + slack(e, ce.u, a, ce.v, b), e, eps_, ce.u, ce.v);
       }
       std::vector<std::uint32_t>().swap(parked_[t]);
     }
