@@ -22,6 +22,9 @@ scaled-jacobian` against IGEMeasure=1 (JacobianDeterminant + IGE passes); each r
 times, the median time reported. Gmsh's ICN and IGE are related to mu and the scaled
 Jacobian but are not equal measures, and they are sampled/estimated values, not certified
 bounds: the comparison is of throughput, with the worst values printed side by side.
+Each round also runs `quadval check --measure validity` on the mesh, and the column
+"x valid" gives the measure's median time over validity's: the cost of the quality
+measure relative to the validity check (issue 5's aim for mu: at most 5x).
 
 --hex-box N also writes (and caches under /tmp/quadval_check_bench/) an N^3 box of linear
 hexahedra with perturbed nodes, MSH 4.1, to measure throughput on a large mesh.
@@ -222,13 +225,15 @@ def median_run(times_and_results):
 
 
 def quality(a, meshes, tool):
-    hdr = "%-36s %-16s %9s %8s %10s %10s %12s %12s %8s %11s %11s" % (
+    hdr = "%-36s %-16s %9s %8s %10s %10s %12s %12s %8s %8s %11s %11s" % (
         "mesh", "quadval vs gmsh", "elements", "inv(g)", "t_q [s]", "t_g [s]", "el/s quadval", "el/s gmsh", "ratio",
-        "worst(q)", "worst(g)")
+        "x valid", "worst(q)", "worst(g)")
     print("quadval: certified lower bounds (lower <= min over the element); Gmsh: ICN/IGE, related")
     print("but not equal measures, not certified bounds. Times: median of %d runs." % a.repeat)
     print("inv(g): elements Gmsh finds invalid, whose ICN and IGE it reports as 0; quadval's mu is")
     print("0 there too, but it bounds the (negative) scaled Jacobian of every invalid element.")
+    print("x valid: quadval's time for the measure over its time for validity alone (--measure")
+    print("validity, run in the same rounds; issue 5 aims at mu within 5x).")
     print(hdr)
     print("-" * len(hdr))
     pairs = [("mu", "JICN", "mu", "worst_ICN"), ("scaled-jacobian", "JIGE", "scaled_jacobian", "worst_IGE")]
@@ -237,8 +242,11 @@ def quality(a, meshes, tool):
             for measure, gmeasures, qkey, gkey in pairs:
                 cmd = [a.quadval, "check", m, "--measure", measure, "--tol", str(a.tol), "--threads", str(a.threads)]
                 gjson = os.path.join(tmp, "g.json")
-                runs, gruns = [], []
+                validity_cmd = [a.quadval, "check", m, "--measure", "validity", "--threads", str(a.threads)]
+                runs, gruns, vruns = [], [], []
                 for _ in range(a.repeat):  # timed without per-element output (see the top); alternating
+                    _, vout, _ = run_measured(validity_cmd + ["--worst", "0"])
+                    vruns.append((summary_seconds(vout), None))
                     rc, out, _ = run_measured(cmd + ["--worst", "0"])
                     if rc not in (0, 1):
                         break
@@ -257,9 +265,10 @@ def quality(a, meshes, tool):
                 lows = [e[key]["lower"] for e in json.load(open(qjson))["elements"] if key in e]
                 worst_q = min(lows) if lows else float("nan")
                 tg, (worst_g, inv_g) = median_run(gruns)
-                print("%-36s %-16s %9d %8d %10.3g %10.3g %12.3g %12.3g %8.1f %11.4g %11.4g" % (
+                tv, _ = median_run(vruns)
+                print("%-36s %-16s %9d %8d %10.3g %10.3g %12.3g %12.3g %8.1f %8.1f %11.4g %11.4g" % (
                     os.path.basename(m)[:36], "%s/%s" % ("mu" if qkey == "mu" else "sj", gmeasures[1:]), n, inv_g,
-                    tq, tg, n / tq, n / tg, tg / tq, worst_q, worst_g))
+                    tq, tg, n / tq, n / tg, tg / tq, tq / tv, worst_q, worst_g))
 
 
 if __name__ == "__main__":
