@@ -245,8 +245,12 @@ def quality(a, meshes, tool):
                 validity_cmd = [a.quadval, "check", m, "--measure", "validity", "--threads", str(a.threads)]
                 runs, gruns, vruns = [], [], []
                 for _ in range(a.repeat):  # timed without per-element output (see the top); alternating
-                    _, vout, _ = run_measured(validity_cmd + ["--worst", "0"])
+                    failed = "validity"
+                    rc, vout, _ = run_measured(validity_cmd + ["--worst", "0"])
+                    if rc not in (0, 1):
+                        break
                     vruns.append((summary_seconds(vout), None))
+                    failed = measure
                     rc, out, _ = run_measured(cmd + ["--worst", "0"])
                     if rc not in (0, 1):
                         break
@@ -255,7 +259,7 @@ def quality(a, meshes, tool):
                     g = json.load(open(gjson))
                     gruns.append((g["t_plugin_run_s"], (g.get(gkey, float("nan")), g["n_invalid_ratio_le_0"])))
                 if len(runs) < a.repeat:
-                    print("%-36s quadval --measure %s failed (exit %d)" % (os.path.basename(m), measure, rc))
+                    print("%-36s quadval --measure %s failed (exit %d)" % (os.path.basename(m), failed, rc))
                     continue
                 tq, n = median_run(runs)
                 # The worst lower bound, from one more run's per-element JSON.
