@@ -136,10 +136,10 @@
 // on uniform-100k-a6 a fifth in the walk over a dissolving tree's nodes (a miss per node),
 // which trees that end in place now spare (their nodes leave when next met; dissolve() in
 // the .cpp: uniform-100k-a6's L1 data misses -14% by cachegrind). There, since, push_edges_
-// of_plus_vertex takes 38% (perf annotate: its samples 34% at the incidence load, 22% at
-// the far end's record, 17% at the edge's cost, 11% at the group's top); the cost stored
-// in the incidence (16-byte records) made the matching slower (5.39 -> 5.76 s, medians of
-// 15 alternating runs).
+// of_plus_vertex takes 36% of the time (perf annotate: its samples 32% at the incidence
+// load, 25% at the far end's record, 15% at the edge's cost, 12% at the group's top); the
+// cost stored in the incidence (16-byte records) made the matching slower (5.39 -> 5.76 s,
+// medians of 15 alternating runs).
 
 #include <cstdint>
 #include <functional>
