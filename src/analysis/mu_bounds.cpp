@@ -22,6 +22,7 @@
 #include "analysis/mu_metric.hpp"
 #include "analysis/mu_space.hpp"
 #include "analysis/outward_rounding.hpp"
+#include "analysis/slot_pool.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/straight_simplex_mu.hpp"
@@ -368,6 +369,7 @@ QualityBounds mu_bounds_given(const ElementType& type, std::span<const double> n
   QV_ASSERT(!track_metric || m_bisection->size() == space.size(2), "M's space");
   const auto w_block = block;
   const auto slot_size = w_block + (track_metric ? static_cast<std::size_t>(m_vectors * space.size(2)) : 0);
+  reserve_slots(pool, slot_size);
   long steps = 0;  // bisections so far
   const auto subdomain_lower = [&](const double* w, double err, double m_err, double r_lo, double r_hi) {
     double lo = r_lo;

@@ -26,6 +26,7 @@
 #include "analysis/scaled_jacobian_quotient.hpp"
 #include "analysis/scalar_or_lanes.hpp"
 #include "analysis/scaled_jacobian_space.hpp"
+#include "analysis/slot_pool.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/straight_sided.hpp"
 #include "analysis/symmetric3_lanes.hpp"
@@ -976,6 +977,7 @@ QualityBounds scaled_jacobian_bounds_given(const ElementType& type, std::span<co
   }
   root_frames.nvec = nvec;
   const std::size_t stride = nvec * s2;
+  reserve_slots(ws.pool, stride);
   ws.pool.assign(stride, 0.0);
   ws.pool_err.assign(nvec, 0.0);
   for (std::size_t q = 0; q < nvec; ++q) {

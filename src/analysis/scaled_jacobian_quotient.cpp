@@ -12,6 +12,7 @@
 #include "analysis/lane_vector.hpp"
 #include "analysis/outward_rounding.hpp"
 #include "analysis/ratio_scan.hpp"
+#include "analysis/slot_pool.hpp"
 #include "analysis/sqrt_rn.hpp"
 #include "analysis/symmetric3_lanes.hpp"
 #include "bezier/bernstein_bisection.hpp"
@@ -915,6 +916,7 @@ QualityBounds refine(const ScaledJacobianSpace& space, const QuotientInput& in, 
   thread_local std::vector<BisectionState> states, child_states;
   thread_local std::vector<int> free_slots;
   thread_local std::vector<Leaf> heap;
+  reserve_slots(pool, stride);
   pool.resize(stride);
   pool_err.assign(1, {});
   pool_frames.resize(1);
