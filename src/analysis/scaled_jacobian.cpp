@@ -91,6 +91,24 @@ constexpr int kSignedSplits = 8;
 bool signed_floor_root_ends(const ElementType& type) {
   return type.family == ElementFamily::tetrahedron || type.family == ElementFamily::triangle;
 }
+// Where the inverted elements' time goes (one thread, each element best of 3). Of
+// warped_tetrahedron_o3's 660, the signed stage settles 505 (14 ms); the other 155 take
+// 29 ms in the full bounds, 14 ms of it in the 17 that need 64 to 222 halvings. The slowest
+// (222, traced) holds a fold point, where a frame column vanishes: on the subdomains split
+// around it D_k is not proven positive, so only the Hadamard bound -s |v_b x v_c| /
+// (|v_b| |v_c|) applies there, and it nears sj's infimum (that quantity at the fold point)
+// only as those subdomains shrink. Likewise 4 quadratic tetrahedra and 2 pyramids of
+// mixed_h0.6_o2 (143-2,642 halvings) take 22 of its 23 ms. Tried and not kept:
+// - The final upper bound given from the start: 8% fewer halvings on warped_tetrahedron_o3's
+//   elements that need 8 or more, none fewer on 15 of the 17 slowest (the lower bound
+//   decides there), so a better upper bound can gain at most that.
+// - Compensating the positive side of a subdomain across the fold: r^2 D_k - N + m J with
+//   nonnegative coefficients also gives sj_k >= -s r (where J < 0 the added term is
+//   negative), with m >= 0 chosen to minimise r (the envelope of the lines
+//   (N_i - m J_i) / D_k,i): warped_tetrahedron_o3 3,195 -> 3,127 subdivisions, 18% slower.
+// - The local search of scaled_jacobian_probe.hpp for the upper bound, at the full bounds'
+//   start: 3,195 -> 2,957 subdivisions, 7% slower; only after 32 halvings: 3,086, the
+//   same time.
 
 // A computed quantity: |computed| <= m and |computed - exact| <= e (Higham's model, one
 // rounding of at most u per operation; the final bounds are enlarged by 1% to cover the
