@@ -43,9 +43,10 @@
 // through `quadval recombine`, whose start leaves 1,504 vertices free: 752 augmentations,
 // 12.5M grows, 850k shrinks, 828k expands; a shrink's cycle holds 5.4 nodes and its walk to
 // the base takes 5.5 steps on average, so shrink's 14% of the time (perf) is spent waiting
-// on memory (the walk's outer() lookups, the groups' boundary lists), not on long walks. The vertex order matters (one run each): without recombine's ordering of
-// the triangles the matching took 10.0 s instead of 6.0 s; starting the breadth-first visit
-// at 0, 25, 37, 50, 75 or 90% of the vertex range, 5.7-6.6 s: no start is much better.)
+// on memory (the walk's outer() lookups, the groups' boundary lists), not on long walks.
+// The vertex order matters (one run each): without recombine's ordering of the triangles
+// the matching took 10.0 s instead of 6.0 s; starting the breadth-first visit at 0, 25, 37,
+// 50, 75 or 90% of the vertex range, 5.7-6.6 s: no start is much better.)
 // - Augmentations 100-300: a few trees of 5k-30k vertices beside about 1,000 of 1-15; when
 //   a big one augments, its region is regrown at the same dual value, 99.9% with the same
 //   labels, about 85% of it by one neighbouring tree.
