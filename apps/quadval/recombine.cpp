@@ -39,6 +39,7 @@ struct RecombineCliOptions {
   bool no_optimize = false, full_quad = false, quiet = false, binary = false;
   bool no_extra_edges = false;
   double extra_edge_cost = 1000.0;
+  double feature_angle = 40.0;
   int horizon = 3, runs = 1;
   std::uint64_t seed = 1;
   bool uniform = false, selective = false, compare_blossom = false;
@@ -75,6 +76,7 @@ nlohmann::json stats_json(const RecombineStats& s) {
   for (const StageTime& t : s.times) times.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
   nlohmann::json j = {
       {"input_triangles", s.input_triangles},   {"odd_splits", s.odd_splits},
+      {"feature_edges", s.feature_edges},
       {"graph_pairs", s.graph_pairs},           {"extra_pairs", s.extra_pairs},
       {"perfect_matching", s.perfect_matching}, {"matched_extra_pairs", s.matched_extra_pairs},
       {"edge_swaps", s.edge_swaps},             {"vertex_duplications", s.vertex_duplications},
@@ -113,6 +115,7 @@ int run(const RecombineCliOptions& o) {
   options.odd_policy = o.odd == "leave" ? OddPolicy::leave_triangle : OddPolicy::split_boundary_edge;
   options.extra_edges = !o.no_extra_edges;
   options.extra_edge_cost = o.extra_edge_cost;
+  options.feature_angle = o.feature_angle;
   options.optimize = !o.no_optimize;
   options.smoothing_passes = o.smooth;
   // The library's parallel loops (pair costs, smoothing, statistics, look-ahead runs) use
@@ -240,9 +243,14 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
   cmd->add_flag("--full-quad", o->full_quad,
                 "Then split each quad into 4 and each triangle into 3 (sizes halve)");
   cmd->add_option("--odd", o->odd,
-                  "Odd triangle count: split (the longest boundary edge, all-quad result) or "
-                  "leave (one triangle stays)")
+                  "Odd triangle count: split (the longest boundary edge, or on a closed surface an edge "
+                  "between two of its pieces; all-quad result) or leave (one triangle stays)")
       ->check(CLI::IsMember({"split", "leave"}))
+      ->capture_default_str();
+  cmd->add_option("--feature-angle", o->feature_angle,
+                  "Surfaces in 3D: edges where the surface turns by more than this many degrees are "
+                  "features, kept like CAD curves (no quad across one, nodes stay on it); 180: none")
+      ->check(CLI::Range(0.0, 180.0))
       ->capture_default_str();
   cmd->add_flag("--no-extra-edges", o->no_extra_edges, "Do not add the extra boundary edges (§5.3)");
   cmd->add_option("--extra-edge-cost", o->extra_edge_cost, "Cost of an extra boundary edge")

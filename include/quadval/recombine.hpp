@@ -42,9 +42,10 @@ enum class PairCostKind {
 /// count: then no perfect matching can exist.
 enum class OddPolicy {
   /// Split the longest boundary edge of each odd piece at its midpoint (its triangle becomes two):
-  /// the count becomes even, the boundary keeps its shape, the result is all-quad. A piece
-  /// without a boundary edge falls back to leave_triangle (a closed manifold surface never
-  /// needs it: 3T = 2E makes its triangle count even).
+  /// the count becomes even, the boundary keeps its shape, the result is all-quad. The odd
+  /// pieces of a closed surface cut at feature edges are made even in pairs, by splitting edges
+  /// between pieces (3T = 2E makes the surface's total even); a piece left odd falls back to
+  /// leave_triangle.
   split_boundary_edge,
   /// Match as many triangles as possible: at least one triangle is left in the output.
   leave_triangle,
@@ -66,6 +67,10 @@ struct RecombineOptions {
   bool extra_edges = true;
   double extra_edge_cost = 1000.0;  ///< Paper I §7 step 3 ("typically 1000")
   OddPolicy odd_policy = OddPolicy::split_boundary_edge;
+  /// Surfaces in 3D: an edge where the two triangles' normals turn by more than this angle
+  /// (degrees) is a feature, kept as CAD curves are: no quad across it, its nodes held (or
+  /// sliding along it where it is straight). 180 or more: no features. Planar meshes have none.
+  double feature_angle = 40.0;
   /// Paper I §6. When false, the matched quads are returned as they are (after repair).
   bool optimize = true;
   int smoothing_passes = 5;        ///< Laplacian sweeps before and after the clean-up; 0: none
@@ -100,7 +105,8 @@ struct StageTime {
 
 struct RecombineStats {
   std::size_t input_triangles = 0;
-  std::size_t odd_splits = 0;            ///< boundary edges split to make a piece even
+  std::size_t odd_splits = 0;            ///< edges split to make the pieces even
+  std::size_t feature_edges = 0;         ///< edges kept as features (RecombineOptions::feature_angle)
   std::size_t graph_pairs = 0;           ///< real pairs (interior edges inside one region)
   std::size_t extra_pairs = 0;           ///< extra boundary edges added (§5.3)
   bool perfect_matching = false;         ///< every triangle matched (blossom) or paired

@@ -5,11 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <utility>
 
 #include <fmt/core.h>
 
 #include "boundary_slide.hpp"
 #include "dual_graph.hpp"
+#include "feature_edges.hpp"
 #include "lookahead_matching.hpp"
 #include "lookahead_parity.hpp"
 #include "matching.hpp"
@@ -183,16 +185,21 @@ Mesh to_mesh(const MixedMesh& m, const Mesh& input, const TriangleSurface& s) {
     out.node_tags.push_back(m.node_tags[v]);
     for (int d = 0; d < 3; ++d) out.coords.push_back(m.coords[3 * std::size_t{v} + d]);
   }
-  // One block per (region, element kind), in region order; element tags 1, 2, ...
+  // One block per (entity, element kind), entities in the order of their first region (the
+  // regions cut from one entity at feature edges share its block); element tags 1, 2, ...
+  std::vector<int> entities;
+  std::map<int, bool> listed;
+  for (int entity : s.region_entity)
+    if (!std::exchange(listed[entity], true)) entities.push_back(entity);
   Tag tag = 1;
   for (int kind : {4, 3}) {
-    for (std::size_t r = 0; r < s.region_entity.size(); ++r) {
+    for (int entity : entities) {
       ElementBlock b;
       b.type = find_element_type(kind == 4 ? 3 : 2);
       b.entity_dim = 2;
-      b.entity_tag = s.region_entity[r];
+      b.entity_tag = entity;
       for (std::size_t e = 0; e < m.elements.size(); ++e) {
-        if (!m.alive[e] || m.region[e] != static_cast<std::int32_t>(r) ||
+        if (!m.alive[e] || s.region_entity[static_cast<std::size_t>(m.region[e])] != entity ||
             MixedMesh::size(m.elements[e]) != kind)
           continue;
         b.tags.push_back(tag++);
@@ -223,6 +230,7 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
     throw InputError::in_file(
         options.source, fmt::format("the cross field has {} angles for {} triangles",
                                     options.cross_field_per_triangle.size(), s.triangles.size()));
+  stats.feature_edges = split_regions_at_features(s, options.feature_angle);
   if (options.odd_policy == OddPolicy::split_boundary_edge) {
     // A perfect matching needs every connected piece of a region even (the dual graph of
     // two pieces has no edge between them), and so does the look-ahead criterion.
@@ -231,16 +239,17 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   stats.odd_splits = s.odd_splits;
   if (s.odd_splits > 0)
     result.warnings.push_back(fmt::format(
-        "{} connected piece(s) had an odd number of triangles: no all-quad matching exists, "
-        "so the longest boundary edge of each was split at its midpoint",
+        "connected pieces with an odd number of triangles have no all-quad matching: {} edge(s) "
+        "were split at their midpoint (the longest boundary edge of an odd piece, or an edge "
+        "between two pieces of a closed surface cut at feature edges)",
         s.odd_splits));
   if (!s.odd_regions_left.empty())
     result.warnings.push_back(fmt::format(
         "{} connected piece(s) have an odd number of triangles and no boundary edge to split: "
         "at least one triangle will remain in each",
         s.odd_regions_left.size()));
-  timer.stage("input", fmt::format("{} triangles, {} regions", stats.input_triangles,
-                                   s.region_entity.size()));
+  timer.stage("input", fmt::format("{} triangles, {} regions, {} feature edges", stats.input_triangles,
+                                   s.region_entity.size(), stats.feature_edges));
 
   // Cross-field angles follow the triangles (split halves inherit their parent's angle).
   std::vector<double> field;
@@ -272,7 +281,7 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   if (!match.perfect && options.algorithm == RecombineAlgorithm::blossom)
     result.warnings.push_back(fmt::format(
         "no perfect matching exists even with the extra edges: {} triangle(s) left unmatched",
-        stats.input_triangles + stats.odd_splits - 2 * match.pairs.size()));
+        s.triangles.size() - 2 * match.pairs.size()));
 
   std::vector<ExtraPair> extra;
   MixedMesh m = mesh_from_matching(s, graph, match, extra);

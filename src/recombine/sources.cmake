@@ -1,6 +1,7 @@
 list(APPEND QUADVAL_SOURCES
   src/recombine/quad_quality.cpp
   src/recombine/triangle_input.cpp
+  src/recombine/feature_edges.cpp
   src/recombine/node_order.cpp
   src/recombine/dual_graph.cpp
   src/recombine/blossom_solver.cpp

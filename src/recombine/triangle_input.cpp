@@ -33,6 +33,114 @@ double squared_distance(const std::vector<double>& x, NodeIndex a, NodeIndex b) 
   return s;
 }
 
+// A new node at the midpoint of edge `ends`.
+NodeIndex add_midpoint(TriangleSurface& s, const std::array<NodeIndex, 2>& ends, Tag& next_tag) {
+  const auto m = static_cast<NodeIndex>(s.node_tags.size());
+  for (int i = 0; i < 3; ++i)
+    s.coords.push_back(0.5 * (s.coords[3 * std::size_t{ends[0]} + i] + s.coords[3 * std::size_t{ends[1]} + i]));
+  s.node_tags.push_back(next_tag++);
+  return m;
+}
+
+// Splits triangle t of `topo` at node m on its edge e: (a, b, c) with e = a-b becomes
+// (a, m, c) and (m, b, c), the same orientation; the two halves may not be paired.
+void split_at(TriangleSurface& s, const TriangleTopology& topo, std::uint32_t t, std::uint32_t e,
+              NodeIndex m, std::vector<char>& used) {
+  const auto v = s.triangles[t];
+  int k = 0;
+  while (topo.triangle_edges[t][k] != e) ++k;
+  const NodeIndex a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
+  s.triangles[t] = {a, m, c};
+  s.forbidden_pairs.push_back({t, static_cast<std::uint32_t>(s.triangles.size())});
+  s.triangles.push_back({m, b, c});
+  s.region.push_back(s.region[t]);
+  s.triangle_tags.push_back(s.triangle_tags[t]);
+  s.input_index.push_back(s.input_index[t]);
+  used[t] = 1;
+}
+
+// Odd regions with no boundary edge ("stuck": the pieces of a closed surface cut at its
+// feature edges, feature_edges.hpp) are made even by splitting edges between two regions
+// (the longest whose triangles no other split took), each split adding a triangle to both.
+// First between odd neighbours; then, over a breadth-first spanning forest of the regions'
+// adjacency, deepest first, a stuck region splits an edge it shares with its parent, which
+// flips the parent's parity. A region with a boundary edge left odd splits that edge later
+// (make_regions_even); a stuck root left odd is reported. On a closed surface every tree
+// holds an even number of odd regions (3T = 2E makes its total even), so none is left.
+void split_interfaces(TriangleSurface& s, const TriangleTopology& topo, std::vector<char>& odd,
+                      const std::vector<char>& has_boundary, std::vector<char>& used, Tag& next_tag) {
+  const std::size_t num_regions = odd.size();
+  const auto stuck = [&](std::uint32_t r) { return odd[r] && !has_boundary[r]; };
+  bool any_stuck = false;
+  for (std::uint32_t r = 0; r < num_regions; ++r) any_stuck |= stuck(r);
+  if (!any_stuck) return;
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> adjacent(num_regions);  // (region, edge)
+  for (std::uint32_t e = 0; e < topo.edges.size(); ++e) {
+    const std::uint32_t first = topo.edge_triangle_offsets[e];
+    if (topo.edge_triangle_offsets[e + 1] - first != 2) continue;
+    const auto r0 = static_cast<std::uint32_t>(s.region[topo.edge_triangles[first]]);
+    const auto r1 = static_cast<std::uint32_t>(s.region[topo.edge_triangles[first + 1]]);
+    if (r0 == r1) continue;
+    adjacent[r0].push_back({r1, e});
+    adjacent[r1].push_back({r0, e});
+  }
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  // The longest edge between regions r and `other` whose triangles no split took, or kNone.
+  const auto edge_between = [&](std::uint32_t r, std::uint32_t other) {
+    std::uint32_t best = kNone;
+    double best_length = -1;
+    for (const auto& [o, e] : adjacent[r]) {
+      const std::uint32_t first = topo.edge_triangle_offsets[e];
+      if (o != other || used[topo.edge_triangles[first]] || used[topo.edge_triangles[first + 1]]) continue;
+      const double length = squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1]);
+      if (length > best_length) {
+        best_length = length;
+        best = e;
+      }
+    }
+    return best;
+  };
+  const auto split_between = [&](std::uint32_t r, std::uint32_t other) {
+    const std::uint32_t e = edge_between(r, other);
+    if (e == kNone) return;
+    const NodeIndex m = add_midpoint(s, topo.edges[e], next_tag);
+    const std::uint32_t first = topo.edge_triangle_offsets[e];
+    split_at(s, topo, topo.edge_triangles[first], e, m, used);
+    split_at(s, topo, topo.edge_triangles[first + 1], e, m, used);
+    ++s.odd_splits;
+    odd[r] ^= 1;
+    odd[other] ^= 1;
+  };
+  // Odd neighbours first, one of them stuck: one split makes both even.
+  for (std::uint32_t r = 0; r < num_regions; ++r)
+    for (std::size_t i = 0; odd[r] && i < adjacent[r].size(); ++i) {
+      const std::uint32_t other = adjacent[r][i].first;
+      if (odd[other] && (stuck(r) || stuck(other))) split_between(r, other);
+    }
+  // The forest grows from the regions with a boundary edge first: a root that ends odd
+  // can then still split a boundary edge.
+  std::vector<std::uint32_t> parent(num_regions, kNone), order, roots;
+  for (std::uint32_t r = 0; r < num_regions; ++r)
+    if (has_boundary[r]) roots.push_back(r);
+  for (std::uint32_t r = 0; r < num_regions; ++r)
+    if (!has_boundary[r]) roots.push_back(r);
+  std::vector<char> seen(num_regions, 0);
+  for (std::uint32_t root : roots) {
+    if (seen[root]) continue;
+    seen[root] = 1;
+    order.push_back(root);
+    for (std::size_t at = order.size() - 1; at < order.size(); ++at)
+      for (const auto& [other, e] : adjacent[order[at]])
+        if (!seen[other]) {
+          seen[other] = 1;
+          parent[other] = order[at];
+          order.push_back(other);
+        }
+  }
+  for (auto it = order.rbegin(); it != order.rend(); ++it)
+    if (stuck(*it) && parent[*it] != kNone) split_between(*it, parent[*it]);  // else left odd: reported
+}
+
 void collect(const Mesh& mesh, const std::string& source, TriangleSurface& s,
              std::vector<std::string>& warnings) {
   std::map<int, std::int32_t> region_of_entity;
@@ -223,22 +331,30 @@ void make_regions_even(TriangleSurface& s) {
   const std::size_t num_regions = s.region_entity.size();
   std::vector<std::size_t> count(num_regions, 0);
   for (std::int32_t r : s.region) ++count[static_cast<std::size_t>(r)];
+  std::vector<char> odd(num_regions, 0);
   bool any_odd = false;
-  for (std::size_t c : count) any_odd |= (c % 2 == 1);
+  for (std::size_t r = 0; r < num_regions; ++r) any_odd |= (odd[r] = count[r] % 2 == 1) != 0;
   if (!any_odd) return;
 
   std::optional<TriangleTopology> built;
   const TriangleTopology& topo = topology_of(s, built);
-  // Longest boundary edge per odd region, preferring edges whose end nodes have 3 or more
-  // triangles: at a node with two, the halves' neighbours could only form a quad with a flat
-  // (180-degree) corner there. (Ranked by the pair, roomy first: a length added to a large
-  // bonus was absorbed by it, which made the first roomy edge win, not the longest.)
+  std::vector<char> has_boundary(num_regions, 0), used(s.triangles.size(), 0);
+  for (std::uint32_t e : topo.boundary_edges)
+    has_boundary[static_cast<std::size_t>(s.region[topo.edge_triangles[topo.edge_triangle_offsets[e]]])] = 1;
+  Tag next_tag = 1;
+  for (Tag t : s.node_tags) next_tag = std::max(next_tag, t + 1);
+  const std::size_t splits_before = s.odd_splits;
+  split_interfaces(s, topo, odd, has_boundary, used, next_tag);
+  // Longest boundary edge per region still odd, preferring edges whose end nodes have 3 or
+  // more triangles: at a node with two, the halves' neighbours could only form a quad with a
+  // flat (180-degree) corner there. (Ranked by the pair, roomy first: a length added to a
+  // large bonus was absorbed by it, which made the first roomy edge win, not the longest.)
   std::vector<std::uint32_t> best_edge(num_regions, kNoTriangle);
   std::vector<std::pair<bool, double>> best_rank(num_regions, {false, -1.0});
   for (std::uint32_t e : topo.boundary_edges) {
     const std::uint32_t t = topo.edge_triangles[topo.edge_triangle_offsets[e]];
     const auto r = static_cast<std::size_t>(s.region[t]);
-    if (count[r] % 2 == 0) continue;
+    if (!odd[r] || used[t]) continue;
     const bool roomy = topo.vertex_triangles[topo.edges[e][0]] >= 3 &&
                        topo.vertex_triangles[topo.edges[e][1]] >= 3;
     const std::pair<bool, double> rank{roomy, squared_distance(s.coords, topo.edges[e][0], topo.edges[e][1])};
@@ -247,33 +363,15 @@ void make_regions_even(TriangleSurface& s) {
       best_edge[r] = e;
     }
   }
-  Tag next_tag = 1;
-  for (Tag t : s.node_tags) next_tag = std::max(next_tag, t + 1);
-  const std::size_t splits_before = s.odd_splits;
   for (std::size_t r = 0; r < num_regions; ++r) {
-    if (count[r] % 2 == 0) continue;
-    if (best_edge[r] == kNoTriangle) {
+    if (!odd[r]) continue;
+    const std::uint32_t e = best_edge[r];
+    if (e == kNoTriangle) {
       s.odd_regions_left.push_back(static_cast<std::int32_t>(r));
       continue;
     }
-    const std::uint32_t e = best_edge[r];
-    const std::uint32_t t = topo.edge_triangles[topo.edge_triangle_offsets[e]];
-    const auto m = static_cast<NodeIndex>(s.node_tags.size());
-    for (int i = 0; i < 3; ++i)
-      s.coords.push_back(0.5 * (s.coords[3 * std::size_t{topo.edges[e][0]} + i] +
-                                s.coords[3 * std::size_t{topo.edges[e][1]} + i]));
-    s.node_tags.push_back(next_tag++);
-    const auto v = s.triangles[t];
-    int k = 0;
-    while (topo.triangle_edges[t][k] != e) ++k;
-    // (a, b, c) with the split edge a-b becomes (a, m, c) and (m, b, c): same orientation.
-    const NodeIndex a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
-    s.triangles[t] = {a, m, c};
-    s.forbidden_pairs.push_back({t, static_cast<std::uint32_t>(s.triangles.size())});
-    s.triangles.push_back({m, b, c});
-    s.region.push_back(s.region[t]);
-    s.triangle_tags.push_back(s.triangle_tags[t]);
-    s.input_index.push_back(s.input_index[t]);
+    const NodeIndex m = add_midpoint(s, topo.edges[e], next_tag);
+    split_at(s, topo, topo.edge_triangles[topo.edge_triangle_offsets[e]], e, m, used);
     ++s.odd_splits;
   }
   if (s.odd_splits > splits_before) s.topology.reset();  // after the loop: `topo` may be it

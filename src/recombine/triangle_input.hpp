@@ -55,8 +55,10 @@ void validate_triangles(TriangleSurface& surface, const std::string& source,
 const TriangleTopology& topology_of(const TriangleSurface& surface, std::optional<TriangleTopology>& built);
 
 /// Splits, in each region with an odd triangle count, its longest boundary edge (an edge with
-/// one triangle in the whole mesh) at the midpoint. Regions without such an edge are listed in
-/// odd_regions_left.
+/// one triangle in the whole mesh) at the midpoint. Odd regions without such an edge (the
+/// pieces of a closed surface cut at its feature edges) are first made even by splitting
+/// edges between two regions (split_interfaces in the .cpp); those that remain odd are
+/// listed in odd_regions_left. s.odd_splits counts the edges split.
 void make_regions_even(TriangleSurface& surface);
 
 /// Signed-area normal (b - a) × (c - a) of a triangle (length = twice its area).

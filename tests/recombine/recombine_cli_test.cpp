@@ -1,4 +1,5 @@
 // `quadval recombine` end to end: exit codes, output file, JSON report.
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -115,6 +116,40 @@ TEST_F(RecombineCli, OddTriangleCountIsReportedAndStillAllQuad) {
   EXPECT_NE(r.output.find("odd number of triangles"), std::string::npos) << r.output;
   const Mesh q = read_mesh(out);
   for (const auto& b : q.blocks) EXPECT_EQ(b.type->gmsh_id, 3);
+}
+
+// An STL cube, two triangles a face: its 12 edges are features by default (the report says
+// so; each face gives one quad), none with --feature-angle 180, and 200 is refused.
+TEST_F(RecombineCli, FeatureAngleOfAnStlCube) {
+  const fs::path in = dir_ / "cube.stl", out = dir_ / "q.msh", report = dir_ / "r.json";
+  {
+    const int corner[8][3] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+    const int face[6][4] = {{0, 3, 2, 1}, {4, 5, 6, 7}, {0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}};
+    std::ofstream f(in);
+    f << "solid cube\n";
+    for (const auto& q : face)
+      for (const auto& t : {std::array<int, 3>{q[0], q[1], q[2]}, std::array<int, 3>{q[0], q[2], q[3]}}) {
+        f << " facet normal 0 0 0\n  outer loop\n";
+        for (int v : t) f << "   vertex " << corner[v][0] << " " << corner[v][1] << " " << corner[v][2] << "\n";
+        f << "  endloop\n endfacet\n";
+      }
+    f << "endsolid cube\n";
+  }
+  const auto features = [&](const std::string& option) {
+    const CliRun r = run_cli("recombine " + in.string() + " -o " + out.string() + " --report " + report.string() +
+                             " -q " + option);
+    EXPECT_EQ(r.code, 0) << r.output;
+    std::ifstream f(report);
+    const auto s = nlohmann::json::parse(f).at("statistics");
+    EXPECT_EQ(s.at("quads").get<std::size_t>(), 6u);
+    EXPECT_EQ(s.at("triangles_left").get<std::size_t>(), 0u);
+    return s.at("feature_edges").get<std::size_t>();
+  };
+  EXPECT_EQ(features(""), 12u);
+  EXPECT_EQ(features("--feature-angle 180"), 0u);
+  const CliRun bad = run_cli("recombine " + in.string() + " -o " + out.string() + " --feature-angle 200");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("--feature-angle"), std::string::npos) << bad.output;
 }
 
 }  // namespace

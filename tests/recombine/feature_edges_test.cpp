@@ -1,0 +1,206 @@
+// Feature edges of surfaces in 3D (feature_edges.hpp): a triangulated cube given as one
+// surface (as an STL is) keeps its shape through recombination, and the odd pieces of a
+// closed surface cut at its features are made even in pairs (make_regions_even).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "quadval/recombine.hpp"
+#include "recombine/feature_edges.hpp"
+#include "recombine/triangle_input.hpp"
+
+namespace quadval {
+namespace {
+
+Mesh triangle_mesh_3d(const std::vector<std::array<double, 3>>& xyz,
+                      const std::vector<std::array<NodeIndex, 3>>& tris) {
+  Mesh m;
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
+    m.node_tags.push_back(i + 1);
+    m.coords.insert(m.coords.end(), xyz[i].begin(), xyz[i].end());
+  }
+  ElementBlock b;
+  b.type = find_element_type(2);
+  b.entity_dim = 2;
+  b.entity_tag = 1;
+  for (std::size_t t = 0; t < tris.size(); ++t) {
+    b.tags.push_back(t + 1);
+    b.nodes.insert(b.nodes.end(), tris[t].begin(), tris[t].end());
+  }
+  m.blocks.push_back(std::move(b));
+  return m;
+}
+
+// The surface of the unit cube, k segments per edge, each face cell cut along a diagonal
+// (alternating), outward; the nodes inside a face jittered within it. With `odd_faces`, the
+// first segment of the edge y = z = 0 gets a midpoint node and its two triangles are split
+// there: the faces y = 0 and z = 0 then hold an odd number of triangles each.
+Mesh cube_surface(int k, unsigned seed, bool odd_faces) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> jitter(-0.25, 0.25);
+  std::vector<std::array<double, 3>> xyz;
+  std::map<std::array<int, 3>, NodeIndex> index;
+  const auto node = [&](std::array<int, 3> p) {
+    auto [it, inserted] = index.emplace(p, static_cast<NodeIndex>(xyz.size()));
+    if (inserted) xyz.push_back({double(p[0]) / k, double(p[1]) / k, double(p[2]) / k});
+    return it->second;
+  };
+  std::vector<std::array<NodeIndex, 3>> tris;
+  for (int a = 0; a < 3; ++a)
+    for (int side : {0, k}) {
+      const int b = (a + 1) % 3, c = (a + 2) % 3;
+      for (int u = 0; u < k; ++u)
+        for (int v = 0; v < k; ++v) {
+          std::array<NodeIndex, 4> q;
+          const int du[4] = {0, 1, 1, 0}, dv[4] = {0, 0, 1, 1};
+          for (int i = 0; i < 4; ++i) {
+            std::array<int, 3> p{};
+            p[a] = side;
+            p[b] = u + du[i];
+            p[c] = v + dv[i];
+            q[i] = node(p);
+          }
+          if (side == 0) std::swap(q[1], q[3]);  // outward: -e_a
+          if ((u + v) % 2 == 0) {
+            tris.push_back({q[0], q[1], q[2]});
+            tris.push_back({q[0], q[2], q[3]});
+          } else {
+            tris.push_back({q[0], q[1], q[3]});
+            tris.push_back({q[1], q[2], q[3]});
+          }
+        }
+    }
+  for (const auto& [p, i] : index) {
+    const int on_sides = (p[0] % k == 0) + (p[1] % k == 0) + (p[2] % k == 0);
+    if (on_sides != 1) continue;  // on a cube edge or corner: stays
+    for (int d = 0; d < 3; ++d)
+      if (p[d] % k != 0) xyz[i][d] += jitter(rng) / k;
+  }
+  if (odd_faces) {
+    const NodeIndex a = index.at({0, 0, 0}), b = index.at({1, 0, 0});
+    const auto m = static_cast<NodeIndex>(xyz.size());
+    xyz.push_back({0.5 / k, 0, 0});
+    const std::size_t count = tris.size();
+    for (std::size_t t = 0; t < count; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const NodeIndex p = tris[t][i], q = tris[t][(i + 1) % 3], r = tris[t][(i + 2) % 3];
+        if ((p == a && q == b) || (p == b && q == a)) {
+          tris[t] = {p, m, r};
+          tris.push_back({m, q, r});
+          break;
+        }
+      }
+  }
+  return triangle_mesh_3d(xyz, tris);
+}
+
+// Distance of x to the cube's surface (for points on or inside it).
+double off_cube(const double* x) {
+  double d = INFINITY;
+  for (int i = 0; i < 3; ++i) d = std::min({d, std::abs(x[i]), std::abs(1 - x[i])});
+  return d;
+}
+
+// Quads whose four corners do not all lie on one face of the cube.
+int quads_across_faces(const Mesh& out) {
+  int across = 0;
+  for (const ElementBlock& b : out.blocks) {
+    if (b.type->num_nodes != 4) continue;
+    for (std::size_t e = 0; e < b.size(); ++e) {
+      const auto n = b.element(e);
+      bool one_face = false;
+      for (int axis = 0; axis < 3 && !one_face; ++axis)
+        for (double plane : {0.0, 1.0}) {
+          bool all = true;
+          for (int i = 0; i < 4; ++i) all = all && std::abs(out.coords[3 * n[i] + axis] - plane) < 1e-12;
+          one_face = one_face || all;
+        }
+      across += one_face ? 0 : 1;
+    }
+  }
+  return across;
+}
+
+TEST(FeatureEdges, CubeKeepsItsShape) {
+  const int k = 8;
+  const Mesh cube = cube_surface(k, 3, false);
+  RecombineResult r = recombine(cube, {});
+  EXPECT_EQ(r.stats.feature_edges, 12u * k);
+  EXPECT_EQ(r.stats.triangles, 0u);
+  EXPECT_EQ(r.stats.quads, 6u * k * k);
+  EXPECT_GT(r.stats.eta_min, 0.0);
+  EXPECT_EQ(quads_across_faces(r.mesh), 0);
+  double worst = 0;
+  for (std::size_t v = 0; v < r.mesh.node_tags.size(); ++v) worst = std::max(worst, off_cube(&r.mesh.coords[3 * v]));
+  EXPECT_LE(worst, 1e-12);
+  // One output block per entity, as in the input.
+  EXPECT_EQ(r.mesh.blocks.size(), 1u);
+
+  // Without features, quads fold over the cube's edges and its nodes leave the surface.
+  RecombineOptions none;
+  none.feature_angle = 180;
+  r = recombine(cube, none);
+  EXPECT_EQ(r.stats.feature_edges, 0u);
+  EXPECT_GT(quads_across_faces(r.mesh), 0);
+}
+
+TEST(FeatureEdges, OddPiecesOfAClosedSurfaceArePairedUp) {
+  const int k = 6;
+  const Mesh cube = cube_surface(k, 5, true);
+  const RecombineResult r = recombine(cube, {});
+  EXPECT_EQ(r.stats.feature_edges, 12u * k + 1);  // the split segment counts twice
+  EXPECT_EQ(r.stats.odd_splits, 1u);
+  EXPECT_EQ(r.stats.triangles, 0u);
+  EXPECT_EQ(r.stats.quads, (6u * 2 * k * k + 2 + 2) / 2);  // +2 odd faces, +2 from the split
+  EXPECT_EQ(quads_across_faces(r.mesh), 0);
+  double worst = 0;
+  for (std::size_t v = 0; v < r.mesh.node_tags.size(); ++v) worst = std::max(worst, off_cube(&r.mesh.coords[3 * v]));
+  EXPECT_LE(worst, 1e-12);
+}
+
+// Two flat strips meeting at a ridge where the surface turns by 30 degrees: a feature for
+// angles below 30, none above.
+TEST(FeatureEdges, ThresholdIsTheTurnOfTheNormals) {
+  const int n = 4;
+  const double turn = 30 * M_PI / 180;
+  std::vector<std::array<double, 3>> xyz;
+  for (int row = 0; row < 3; ++row)
+    for (int i = 0; i <= n; ++i) {
+      const double y = row - 1.0;  // rows -1, 0 (the ridge), 1
+      xyz.push_back({double(i), y < 0 ? y : y * std::cos(turn), y > 0 ? y * std::sin(turn) : 0.0});
+    }
+  std::vector<std::array<NodeIndex, 3>> tris;
+  for (int row = 0; row < 2; ++row)
+    for (int i = 0; i < n; ++i) {
+      const auto p = static_cast<NodeIndex>(row * (n + 1) + i), q = static_cast<NodeIndex>(p + n + 1);
+      tris.push_back({p, static_cast<NodeIndex>(p + 1), static_cast<NodeIndex>(q + 1)});
+      tris.push_back({p, static_cast<NodeIndex>(q + 1), q});
+    }
+  const Mesh roof = triangle_mesh_3d(xyz, tris);
+  for (const auto& [angle, expected] : std::vector<std::pair<double, std::size_t>>{{40, 0}, {31, 0}, {29, n}, {10, n}}) {
+    std::vector<std::string> warnings;
+    recombine_detail::TriangleSurface s = recombine_detail::prepare_triangles(roof, "roof", warnings);
+    EXPECT_EQ(recombine_detail::split_regions_at_features(s, angle), expected) << angle;
+    EXPECT_EQ(s.region_entity.size(), expected > 0 ? 2u : 1u) << angle;
+  }
+}
+
+// Every face of a tetrahedron is a feature-bounded piece of one triangle, which no split
+// could make a quad: they join their neighbours, and the four triangles give two quads.
+TEST(FeatureEdges, SingleTrianglePiecesJoinANeighbour) {
+  const Mesh tet = triangle_mesh_3d({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+                                    {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
+  const RecombineResult r = recombine(tet, {});
+  EXPECT_EQ(r.stats.feature_edges, 0u);
+  EXPECT_EQ(r.stats.odd_splits, 0u);
+  EXPECT_EQ(r.stats.quads, 2u);
+  EXPECT_EQ(r.stats.triangles, 0u);
+}
+
+}  // namespace
+}  // namespace quadval
