@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <utility>
 
 #include <fmt/core.h>
@@ -23,6 +24,7 @@
 #include "refine.hpp"
 #include "repair.hpp"
 #include "smoothing.hpp"
+#include "surface_projection.hpp"
 #include "triangle_input.hpp"
 
 namespace quadval {
@@ -123,17 +125,49 @@ std::size_t smooth_near(MixedMesh& m, const std::vector<char>& fixed, const std:
   return smooth(m, held, smoothing);
 }
 
+// Brings the nodes the clean-up moved (a quad-vertex-merge's node at the middle of a
+// diagonal, the relaxation around a diagonal swap) back onto the input surface, each only
+// where the elements around it stay valid or get no worse.
+void project_moved_nodes(MixedMesh& m, const std::vector<double>& before, SurfaceProjection& surface) {
+  surface.reserve_nodes(m.num_nodes());
+  const std::vector<std::vector<std::uint32_t>> at = node_elements(m);
+  for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
+    const std::size_t i = 3 * std::size_t{v};
+    if (at[v].empty() || (i < before.size() && m.coords[i] == before[i] && m.coords[i + 1] == before[i + 1] &&
+                          m.coords[i + 2] == before[i + 2]))
+      continue;
+    const auto least = [&] {
+      double worst = 2.0;
+      for (std::uint32_t e : at[v]) worst = std::min(worst, element_score(m, e));
+      return worst;
+    };
+    const auto x = m.point(v);
+    const auto& el = m.elements[at[v][0]];
+    const double old_worst = least();
+    const auto on = surface.project(v, x, next_corner(el, corner_of(el, v)));
+    for (int d = 0; d < 3; ++d) m.coords[i + d] = on[d];
+    const double new_worst = least();
+    if (!(new_worst > 0 || new_worst >= old_worst))
+      for (int d = 0; d < 3; ++d) m.coords[i + d] = x[d];
+  }
+}
+
 void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& options,
               RecombineStats& stats, StageTimer& timer) {
   const std::vector<char> fixed = region_boundary_nodes(m);
   const auto slides = straight_boundary_slides(m, fixed);
+  std::optional<SurfaceProjection> surface;
+  if (!s.planar) surface.emplace(s);
   SmoothingOptions smoothing{options.smoothing_passes,
                              options.size_field ? &options.size_field : nullptr, !s.planar,
                              &slides};
+  smoothing.surface = surface ? &*surface : nullptr;
   stats.smoothing_moves += smooth(m, fixed, smoothing);
   timer.stage("smooth", fmt::format("{} passes, {} moves", options.smoothing_passes,
                                     stats.smoothing_moves));
+  const std::vector<double> before_cleanup = surface ? m.coords : std::vector<double>{};
   const CleanupCounts c = cleanup_quads(m, fixed, options.max_cleanup_passes);
+  if (surface) project_moved_nodes(m, before_cleanup, *surface);
   const auto slides_after = straight_boundary_slides(m, fixed);  // the clean-up edits elements
   smoothing.slides = &slides_after;
   stats.vertex_merges += c.vertex_merges;
@@ -153,7 +187,9 @@ void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& op
   }
   if (options.max_cleanup_passes > 0) {
     std::vector<char> near;
+    const std::vector<double> before_swaps = surface ? m.coords : std::vector<double>{};
     const std::size_t swaps = swap_worst(m, fixed, 0.002, 2, &near);
+    if (surface && swaps > 0) project_moved_nodes(m, before_swaps, *surface);
     stats.diagonal_swaps += swaps;
     timer.stage("swap", fmt::format("{} diagonal swaps at the worst quads", swaps));
     if (swaps > 0 && options.smoothing_passes > 0) {

@@ -301,6 +301,7 @@ bool Smoother::try_move(NodeIndex v, bool raise_mean, double global_min,
   const bool sliding = fixed_[v] != 0;  // only the sliding fixed nodes are in the order
   const std::array<double, 3> x = m_.point(v);
   double sum[3] = {0, 0, 0}, weights = 0, old_min = 2.0, old_sum = 0.0;
+  NodeIndex near = v;  // a neighbour, where v has no place on the surface yet
   std::array<double, 3> normal{0, 0, 0};
   for (std::uint32_t i = first; i < last; ++i) {
     const std::uint32_t e = topo_.star[i];
@@ -311,6 +312,7 @@ bool Smoother::try_move(NodeIndex v, bool raise_mean, double global_min,
     // Each edge neighbour appears in two elements at an interior node: each counts once
     // per element, which weighs them equally.
     for (NodeIndex j : topo_.star_sides[i]) {
+      near = j;
       const double* y = m_.coords.data() + 3 * std::size_t{j};
       double w = 1.0;
       if (options_.size_field != nullptr) {
@@ -352,6 +354,10 @@ bool Smoother::try_move(NodeIndex v, bool raise_mean, double global_min,
       if (!(s > 0 && s < ll)) continue;
     }
     for (int d = 0; d < 3; ++d) position[d] = x[d] + fraction * move[d];
+    if (options_.surface != nullptr && !sliding) {
+      const auto on = options_.surface->project(v, {position[0], position[1], position[2]}, near);
+      for (int d = 0; d < 3; ++d) position[d] = on[d];
+    }
     // Phase 1: never lower the worst element at v. Phase 2: also take moves that raise the
     // sum of the scores at v while keeping them above the mesh's worst at the sweep's start.
     // A score below old_min that also fails phase 2's floor refuses the move at once.
@@ -411,6 +417,7 @@ std::size_t Smoother::run() {
 
 std::size_t smooth(MixedMesh& m, const std::vector<char>& fixed, const SmoothingOptions& options) {
   if (options.passes <= 0) return 0;
+  if (options.surface != nullptr) options.surface->reserve_nodes(m.num_nodes());
   return Smoother(m, fixed, options).run();
 }
 
@@ -506,8 +513,11 @@ std::size_t polish_node(MixedMesh& m, NodeIndex v, std::span<const std::uint32_t
       const auto& dir = k < 2 ? d1 : d2;
       const double step = (k % 2 == 0 ? h : -h);
       const auto x = m.point(v);
-      const std::array<double, 3> y{x[0] + step * dir[0], x[1] + step * dir[1],
-                                    x[2] + step * dir[2]};
+      std::array<double, 3> y{x[0] + step * dir[0], x[1] + step * dir[1], x[2] + step * dir[2]};
+      if (options.surface != nullptr && !sliding) {
+        const auto& el = m.elements[star[0]];
+        y = options.surface->project(v, y, next_corner(el, corner_of(el, v)));
+      }
       if (sliding) {  // strictly inside the side a-b
         double s = 0, ll = 0;
         for (int q = 0; q < 3; ++q) {
@@ -533,6 +543,7 @@ std::size_t polish_node(MixedMesh& m, NodeIndex v, std::span<const std::uint32_t
 
 std::size_t polish_worst(MixedMesh& m, const std::vector<char>& fixed,
                          const SmoothingOptions& options, double share) {
+  if (options.surface != nullptr) options.surface->reserve_nodes(m.num_nodes());
   const std::vector<std::vector<std::uint32_t>> at = node_elements(m);
   std::vector<std::pair<double, std::uint32_t>> worst;
   for (std::size_t e = 0; e < m.elements.size(); ++e)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "mixed_mesh.hpp"
+#include "surface_projection.hpp"
 #include "quadval/recombine.hpp"
 
 namespace quadval::recombine_detail {
@@ -47,6 +48,9 @@ struct SmoothingOptions {
   /// Movable nodes per block of the sweep (smoothing_order): blocks of one colour are
   /// smoothed in parallel.
   int block = 512;
+  /// Optional, for surfaces in 3D: every trial position of a free node is first brought back
+  /// to the input surface (surface_projection.hpp), so the nodes stay on it.
+  SurfaceProjection* surface = nullptr;
 };
 
 /// Smooths the free nodes (fixed[v] == 0, and the fixed ones that may slide) in place, one

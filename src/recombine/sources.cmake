@@ -9,6 +9,7 @@ list(APPEND QUADVAL_SOURCES
   src/recombine/mixed_mesh.cpp
   src/recombine/repair.cpp
   src/recombine/smoothing.cpp
+  src/recombine/surface_projection.cpp
   src/recombine/boundary_slide.cpp
   src/recombine/quad_cleanup.cpp
   src/recombine/refine.cpp

@@ -1,6 +1,7 @@
-// Feature edges of surfaces in 3D (feature_edges.hpp): a triangulated cube given as one
-// surface (as an STL is) keeps its shape through recombination, and the odd pieces of a
-// closed surface cut at its features are made even in pairs (make_regions_even).
+// Surfaces in 3D: a triangulated cube given as one surface (as an STL is) keeps its shape
+// through recombination (feature_edges.hpp), the odd pieces of a closed surface cut at its
+// features are made even in pairs (make_regions_even), and the nodes of a sphere stay on it
+// (surface_projection.hpp).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -200,6 +201,74 @@ TEST(FeatureEdges, SingleTrianglePiecesJoinANeighbour) {
   EXPECT_EQ(r.stats.odd_splits, 0u);
   EXPECT_EQ(r.stats.quads, 2u);
   EXPECT_EQ(r.stats.triangles, 0u);
+}
+
+// An icosphere of radius 1 (icosahedron, each triangle cut in 4 `levels` times, the new
+// nodes pushed out to the sphere), its nodes then moved along the sphere at random.
+Mesh icosphere(int levels, unsigned seed) {
+  const double g = (1 + std::sqrt(5.0)) / 2;
+  std::vector<std::array<double, 3>> xyz = {{-1, g, 0}, {1, g, 0}, {-1, -g, 0}, {1, -g, 0}, {0, -1, g}, {0, 1, g},
+                                            {0, -1, -g}, {0, 1, -g}, {g, 0, -1}, {g, 0, 1}, {-g, 0, -1}, {-g, 0, 1}};
+  std::vector<std::array<NodeIndex, 3>> tris = {{0, 11, 5}, {0, 5, 1}, {0, 1, 7}, {0, 7, 10}, {0, 10, 11},
+                                                 {1, 5, 9}, {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                                                 {3, 9, 4}, {3, 4, 2}, {3, 2, 6}, {3, 6, 8}, {3, 8, 9},
+                                                 {4, 9, 5}, {2, 4, 11}, {6, 2, 10}, {8, 6, 7}, {9, 8, 1}};
+  const auto unit = [](std::array<double, 3> p) {
+    const double l = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    return std::array<double, 3>{p[0] / l, p[1] / l, p[2] / l};
+  };
+  for (auto& p : xyz) p = unit(p);
+  for (int level = 0; level < levels; ++level) {
+    std::map<std::pair<NodeIndex, NodeIndex>, NodeIndex> middle;
+    const auto mid = [&](NodeIndex a, NodeIndex b) {
+      auto [it, inserted] = middle.emplace(std::minmax(a, b), static_cast<NodeIndex>(xyz.size()));
+      if (inserted)
+        xyz.push_back(unit({xyz[a][0] + xyz[b][0], xyz[a][1] + xyz[b][1], xyz[a][2] + xyz[b][2]}));
+      return it->second;
+    };
+    std::vector<std::array<NodeIndex, 3>> finer;
+    for (const auto& t : tris) {
+      const NodeIndex ab = mid(t[0], t[1]), bc = mid(t[1], t[2]), ca = mid(t[2], t[0]);
+      finer.insert(finer.end(), {{t[0], ab, ca}, {t[1], bc, ab}, {t[2], ca, bc}, {ab, bc, ca}});
+    }
+    tris = std::move(finer);
+  }
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.25, 0.25);
+  const double h = 1.1 / (1 << levels);  // about the edge length
+  for (auto& p : xyz) p = unit({p[0] + u(rng) * h, p[1] + u(rng) * h, p[2] + u(rng) * h});
+  return triangle_mesh_3d(xyz, tris);
+}
+
+// The nodes of a recombined curved surface stay on it: within the input triangles' own
+// distance to the sphere (what smoothing in tangent planes and merges at the middle of
+// diagonals did not keep), and the sphere has no features.
+TEST(SurfaceProjection, SphereNodesStayOnTheSurface) {
+  const Mesh sphere = icosphere(4, 7);
+  double sag = 0;  // the deepest point of an input triangle below the sphere
+  for (std::size_t e = 0; e < sphere.blocks[0].size(); ++e) {
+    const auto n = sphere.blocks[0].element(e);
+    const double* a = &sphere.coords[3 * n[0]];
+    const double* b = &sphere.coords[3 * n[1]];
+    const double* c = &sphere.coords[3 * n[2]];
+    const std::array<double, 3> u{b[0] - a[0], b[1] - a[1], b[2] - a[2]}, v{c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    const std::array<double, 3> w{u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+    const double plane = std::abs(w[0] * a[0] + w[1] * a[1] + w[2] * a[2]) / std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    sag = std::max(sag, 1 - plane);
+  }
+  const RecombineResult r = recombine(sphere, {});
+  EXPECT_EQ(r.stats.feature_edges, 0u);
+  EXPECT_EQ(r.stats.triangles, 0u);
+  EXPECT_GT(r.stats.vertex_merges, 0u);  // merges happened, and moved nodes
+  double below = 0, above = 0;
+  for (std::size_t v = 0; v < r.mesh.node_tags.size(); ++v) {
+    const double* x = &r.mesh.coords[3 * v];
+    const double radius = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    below = std::max(below, 1 - radius);
+    above = std::max(above, radius - 1);
+  }
+  EXPECT_LE(below, sag + 1e-12);
+  EXPECT_LE(above, sag);
 }
 
 }  // namespace
