@@ -125,43 +125,55 @@ std::size_t smooth_near(MixedMesh& m, const std::vector<char>& fixed, const std:
   return smooth(m, held, smoothing);
 }
 
-// Brings the nodes the clean-up moved (a quad-vertex-merge's node at the middle of a
-// diagonal, the relaxation around a diagonal swap) back onto the input surface, each only
-// where the elements around it stay valid or get no worse.
+// Brings the nodes moved since `before` (a quad-vertex-merge's node at the middle of a
+// diagonal, the relaxation around a diagonal swap) or added after it (refine_to_quads' edge
+// midpoints and quad centres) back onto the input surface, each only where the elements
+// around it stay valid or get no worse. A node starts its walk from a neighbour's triangle
+// when it has none: the nodes none of whose neighbours has one yet (quad centres after a
+// refinement) wait for a second round.
 void project_moved_nodes(MixedMesh& m, const std::vector<double>& before, SurfaceProjection& surface) {
   surface.reserve_nodes(m.num_nodes());
   const std::vector<std::vector<std::uint32_t>> at = node_elements(m);
+  const auto least = [&](NodeIndex v) {
+    double worst = 2.0;
+    for (std::uint32_t e : at[v]) worst = std::min(worst, element_score(m, e));
+    return worst;
+  };
+  std::vector<NodeIndex> waiting;
+  const auto place = [&](NodeIndex v) {
+    NodeIndex near = kNoNode;
+    for (std::uint32_t e : at[v])
+      for (int k = 0; k < MixedMesh::size(m.elements[e]); ++k)
+        if (near == kNoNode && m.elements[e][k] != v && surface.placed(m.elements[e][k])) near = m.elements[e][k];
+    if (near == kNoNode && !surface.placed(v)) return false;
+    const std::size_t i = 3 * std::size_t{v};
+    const auto x = m.point(v);
+    const double old_worst = least(v);
+    const auto on = surface.project(v, x, near == kNoNode ? v : near);
+    for (int d = 0; d < 3; ++d) m.coords[i + d] = on[d];
+    const double new_worst = least(v);
+    if (!(new_worst > 0 || new_worst >= old_worst))
+      for (int d = 0; d < 3; ++d) m.coords[i + d] = x[d];
+    return true;
+  };
   for (NodeIndex v = 0; v < m.num_nodes(); ++v) {
     const std::size_t i = 3 * std::size_t{v};
     if (at[v].empty() || (i < before.size() && m.coords[i] == before[i] && m.coords[i + 1] == before[i + 1] &&
                           m.coords[i + 2] == before[i + 2]))
       continue;
-    const auto least = [&] {
-      double worst = 2.0;
-      for (std::uint32_t e : at[v]) worst = std::min(worst, element_score(m, e));
-      return worst;
-    };
-    const auto x = m.point(v);
-    const auto& el = m.elements[at[v][0]];
-    const double old_worst = least();
-    const auto on = surface.project(v, x, next_corner(el, corner_of(el, v)));
-    for (int d = 0; d < 3; ++d) m.coords[i + d] = on[d];
-    const double new_worst = least();
-    if (!(new_worst > 0 || new_worst >= old_worst))
-      for (int d = 0; d < 3; ++d) m.coords[i + d] = x[d];
+    if (!place(v)) waiting.push_back(v);
   }
+  for (NodeIndex v : waiting) place(v);
 }
 
-void optimize(MixedMesh& m, const TriangleSurface& s, const RecombineOptions& options,
-              RecombineStats& stats, StageTimer& timer) {
+void optimize(MixedMesh& m, const TriangleSurface& s, SurfaceProjection* surface,
+              const RecombineOptions& options, RecombineStats& stats, StageTimer& timer) {
   const std::vector<char> fixed = region_boundary_nodes(m);
   const auto slides = straight_boundary_slides(m, fixed);
-  std::optional<SurfaceProjection> surface;
-  if (!s.planar) surface.emplace(s);
   SmoothingOptions smoothing{options.smoothing_passes,
                              options.size_field ? &options.size_field : nullptr, !s.planar,
                              &slides};
-  smoothing.surface = surface ? &*surface : nullptr;
+  smoothing.surface = surface;
   stats.smoothing_moves += smooth(m, fixed, smoothing);
   timer.stage("smooth", fmt::format("{} passes, {} moves", options.smoothing_passes,
                                     stats.smoothing_moves));
@@ -334,15 +346,21 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
                                     "duplications", extra.size(), repaired.edge_swaps,
                                     repaired.vertex_duplications));
 
-  if (options.optimize) optimize(m, s, options, stats, timer);
+  // Surfaces in 3D: the input triangles, which the moved and added nodes are kept on.
+  std::optional<SurfaceProjection> surface;
+  if (!s.planar && (options.optimize || options.full_quad)) surface.emplace(s);
+  if (options.optimize) optimize(m, s, surface ? &*surface : nullptr, options, stats, timer);
   if (options.full_quad) {
+    const std::vector<double> before = surface ? m.coords : std::vector<double>{};
     m = refine_to_quads(m, next_tag);
+    if (surface) project_moved_nodes(m, before, *surface);
     timer.stage("refine", fmt::format("{} quads", m.elements.size()));
     if (options.optimize && options.smoothing_passes > 0) {
       const std::vector<char> fixed = region_boundary_nodes(m);
-      stats.smoothing_moves += smooth(m, fixed, {options.smoothing_passes,
-                                                 options.size_field ? &options.size_field : nullptr,
-                                                 !s.planar});
+      SmoothingOptions smoothing{options.smoothing_passes, options.size_field ? &options.size_field : nullptr,
+                                 !s.planar};
+      smoothing.surface = surface ? &*surface : nullptr;
+      stats.smoothing_moves += smooth(m, fixed, smoothing);
       timer.stage("smooth", "after refinement");
     }
   }

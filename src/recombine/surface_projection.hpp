@@ -35,6 +35,9 @@ class SurfaceProjection {
   /// nodes are not being projected at the same time.
   std::array<double, 3> project(NodeIndex v, const std::array<double, 3>& p, NodeIndex near);
 
+  /// Whether node v has a triangle to start from (an input node, or one projected since).
+  bool placed(NodeIndex v) const { return v < host_.size() && host_[v] != 0xffffffffu; }
+
  private:
   struct Nearest {
     std::array<double, 3> point;

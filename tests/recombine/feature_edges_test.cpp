@@ -256,19 +256,23 @@ TEST(SurfaceProjection, SphereNodesStayOnTheSurface) {
     const double plane = std::abs(w[0] * a[0] + w[1] * a[1] + w[2] * a[2]) / std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
     sag = std::max(sag, 1 - plane);
   }
-  const RecombineResult r = recombine(sphere, {});
-  EXPECT_EQ(r.stats.feature_edges, 0u);
-  EXPECT_EQ(r.stats.triangles, 0u);
-  EXPECT_GT(r.stats.vertex_merges, 0u);  // merges happened, and moved nodes
-  double below = 0, above = 0;
-  for (std::size_t v = 0; v < r.mesh.node_tags.size(); ++v) {
-    const double* x = &r.mesh.coords[3 * v];
-    const double radius = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-    below = std::max(below, 1 - radius);
-    above = std::max(above, radius - 1);
+  for (const bool full_quad : {false, true}) {  // refinement adds nodes at chords' middles
+    RecombineOptions o;
+    o.full_quad = full_quad;
+    const RecombineResult r = recombine(sphere, o);
+    EXPECT_EQ(r.stats.feature_edges, 0u);
+    EXPECT_EQ(r.stats.triangles, 0u);
+    EXPECT_GT(r.stats.vertex_merges, 0u);  // merges happened, and moved nodes
+    double below = 0, above = 0;
+    for (std::size_t v = 0; v < r.mesh.node_tags.size(); ++v) {
+      const double* x = &r.mesh.coords[3 * v];
+      const double radius = std::sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+      below = std::max(below, 1 - radius);
+      above = std::max(above, radius - 1);
+    }
+    EXPECT_LE(below, sag + 1e-12) << full_quad;
+    EXPECT_LE(above, sag) << full_quad;
   }
-  EXPECT_LE(below, sag + 1e-12);
-  EXPECT_LE(above, sag);
 }
 
 }  // namespace
