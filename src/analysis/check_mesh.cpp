@@ -53,8 +53,8 @@ namespace {
 // first-order fast path; fewer for the others, whose per-thread scratch (nodes and J
 // coefficients of a chunk) is first touched, page by page, within the timed analysis
 // (tri_h0.4_o4: 0.34 -> 0.29 ms with 64 instead of 256). 16 instead of 64 (CLI, 2 threads,
-// medians of 11 alternating runs): sj of warped_pyramid_o2 -12% and warped_prism_o2 -6%,
-// but tets_h0.8_o2 mu +19% and sj +10%, the others within noise; not kept.
+// medians of 11 alternating runs): sj of warped_prism_o2 -5%, but its mu +7% and
+// tets_h0.8_o2's mu and sj +8-9%, the others within 4%; not kept.
 constexpr std::size_t kFastChunk = kLinearChunk;
 constexpr std::size_t kChunk = 64;
 constexpr std::size_t kRow = kChunk + 8;  // straight-sided chunks' vertex rows, a cache line apart
