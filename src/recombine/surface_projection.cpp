@@ -1,5 +1,6 @@
 #include "surface_projection.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
@@ -153,7 +154,17 @@ std::array<double, 3> SurfaceProjection::project(NodeIndex v, const std::array<d
     best = found;
   }
   if (v < host_.size()) host_[v] = t;
-  return lifted(t, best.point, best.bary);
+  const auto on = lifted(t, best.point, best.bary);
+  // A point already on the surface (a move within a flat face) is kept to the bit, not
+  // replaced by its own image rounded: the smoothing of flat faces stays as it was.
+  double scale2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double* a = &coords_[3 * std::size_t{triangles_[t][k]}];
+    const double* b = &coords_[3 * std::size_t{triangles_[t][(k + 1) % 3]}];
+    scale2 = std::max(scale2, (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
+  const auto d = minus(on, p);
+  return dot(d, d) <= 1e-24 * scale2 ? p : on;
 }
 
 }  // namespace quadval::recombine_detail
