@@ -13,29 +13,13 @@
 
 #include "quadval/recombine.hpp"
 #include "recombine/feature_edges.hpp"
+#include "recombine/test_meshes.hpp"
 #include "recombine/triangle_input.hpp"
 
 namespace quadval {
 namespace {
 
-Mesh triangle_mesh_3d(const std::vector<std::array<double, 3>>& xyz,
-                      const std::vector<std::array<NodeIndex, 3>>& tris) {
-  Mesh m;
-  for (std::size_t i = 0; i < xyz.size(); ++i) {
-    m.node_tags.push_back(i + 1);
-    m.coords.insert(m.coords.end(), xyz[i].begin(), xyz[i].end());
-  }
-  ElementBlock b;
-  b.type = find_element_type(2);
-  b.entity_dim = 2;
-  b.entity_tag = 1;
-  for (std::size_t t = 0; t < tris.size(); ++t) {
-    b.tags.push_back(t + 1);
-    b.nodes.insert(b.nodes.end(), tris[t].begin(), tris[t].end());
-  }
-  m.blocks.push_back(std::move(b));
-  return m;
-}
+using test::make_triangle_mesh_3d;
 
 // The surface of the unit cube, k segments per edge, each face cell cut along a diagonal
 // (alternating), outward; the nodes inside a face jittered within it. With `odd_faces`, the
@@ -97,7 +81,7 @@ Mesh cube_surface(int k, unsigned seed, bool odd_faces) {
         }
       }
   }
-  return triangle_mesh_3d(xyz, tris);
+  return make_triangle_mesh_3d(xyz, tris);
 }
 
 // Distance of x to the cube's surface (for points on or inside it).
@@ -182,7 +166,7 @@ TEST(FeatureEdges, ThresholdIsTheTurnOfTheNormals) {
       tris.push_back({p, static_cast<NodeIndex>(p + 1), static_cast<NodeIndex>(q + 1)});
       tris.push_back({p, static_cast<NodeIndex>(q + 1), q});
     }
-  const Mesh roof = triangle_mesh_3d(xyz, tris);
+  const Mesh roof = make_triangle_mesh_3d(xyz, tris);
   for (const auto& [angle, expected] : std::vector<std::pair<double, std::size_t>>{{40, 0}, {31, 0}, {29, n}, {10, n}}) {
     std::vector<std::string> warnings;
     recombine_detail::TriangleSurface s = recombine_detail::prepare_triangles(roof, "roof", warnings);
@@ -194,7 +178,7 @@ TEST(FeatureEdges, ThresholdIsTheTurnOfTheNormals) {
 // Every face of a tetrahedron is a feature-bounded piece of one triangle, which no split
 // could make a quad: they join their neighbours, and the four triangles give two quads.
 TEST(FeatureEdges, SingleTrianglePiecesJoinANeighbour) {
-  const Mesh tet = triangle_mesh_3d({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
+  const Mesh tet = make_triangle_mesh_3d({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}},
                                     {{0, 2, 1}, {0, 1, 3}, {1, 2, 3}, {0, 3, 2}});
   const RecombineResult r = recombine(tet, {});
   EXPECT_EQ(r.stats.feature_edges, 0u);
@@ -237,7 +221,7 @@ Mesh icosphere(int levels, unsigned seed) {
   std::uniform_real_distribution<double> u(-0.25, 0.25);
   const double h = 1.1 / (1 << levels);  // about the edge length
   for (auto& p : xyz) p = unit({p[0] + u(rng) * h, p[1] + u(rng) * h, p[2] + u(rng) * h});
-  return triangle_mesh_3d(xyz, tris);
+  return make_triangle_mesh_3d(xyz, tris);
 }
 
 // The nodes of a recombined curved surface stay on it: within the input triangles' own

@@ -11,13 +11,13 @@
 
 namespace quadval::test {
 
-/// A planar triangle mesh (z = 0), one block of Triangle 3 on entity (2, 1), tags 1..n.
-inline Mesh make_triangle_mesh(const std::vector<std::array<double, 2>>& xy,
-                               const std::vector<std::array<NodeIndex, 3>>& tris) {
+/// A triangle mesh: one block of Triangle 3 on entity (2, 1), tags 1..n, on the nodes `xyz`.
+inline Mesh make_triangle_mesh_3d(const std::vector<std::array<double, 3>>& xyz,
+                                  const std::vector<std::array<NodeIndex, 3>>& tris) {
   Mesh m;
-  for (std::size_t i = 0; i < xy.size(); ++i) {
+  for (std::size_t i = 0; i < xyz.size(); ++i) {
     m.node_tags.push_back(i + 1);
-    m.coords.insert(m.coords.end(), {xy[i][0], xy[i][1], 0.0});
+    m.coords.insert(m.coords.end(), xyz[i].begin(), xyz[i].end());
   }
   ElementBlock b;
   b.type = find_element_type(2);
@@ -29,6 +29,14 @@ inline Mesh make_triangle_mesh(const std::vector<std::array<double, 2>>& xy,
   }
   m.blocks.push_back(std::move(b));
   return m;
+}
+
+/// A planar triangle mesh (z = 0), as make_triangle_mesh_3d.
+inline Mesh make_triangle_mesh(const std::vector<std::array<double, 2>>& xy,
+                               const std::vector<std::array<NodeIndex, 3>>& tris) {
+  std::vector<std::array<double, 3>> xyz;
+  for (const auto& p : xy) xyz.push_back({p[0], p[1], 0.0});
+  return make_triangle_mesh_3d(xyz, tris);
 }
 
 /// Jittered nx × ny grid on [0, nx] × [0, ny], each cell cut along a random diagonal
