@@ -78,15 +78,6 @@ std::size_t split_regions_at_features(TriangleSurface& s, double angle_degrees) 
     joined[t] = 1;
     root[find(piece[t])] = find(piece[best]);
   }
-  // Features: the edges between two triangles of one region that turn too much, except
-  // those of a joined triangle.
-  const auto feature = [&](std::uint32_t t, std::uint32_t u) {
-    return s.region[u] == s.region[t] && !joined[t] && !joined[u] && is_feature(t, u);
-  };
-  std::size_t features = 0;
-  for (std::uint32_t t = 0; t < n; ++t)
-    for (std::uint32_t u : topo.neighbors[t]) features += u != kNoTriangle && t < u && feature(t, u) ? 1 : 0;
-  if (features == 0) return 0;
   // Regions: the joined pieces, numbered in the order of their first triangle.
   std::vector<std::int32_t> region(n);
   std::vector<std::int32_t> number(size.size(), -1);
@@ -99,11 +90,24 @@ std::size_t split_regions_at_features(TriangleSurface& s, double angle_degrees) 
     }
     region[t] = number[p];
   }
-  // A feature that ends inside its region (a crease that does not cut the surface in two)
-  // still bounds no quad: its two triangles are a forbidden pair.
+  // Features: the edges of one input region between two of the new ones, and those that
+  // turn too much inside a new one (a crease that does not cut the surface in two, other
+  // than a joined triangle's), which still bound no quad: their triangles are a forbidden
+  // pair.
+  std::size_t features = 0;
+  std::vector<std::array<std::uint32_t, 2>> creases;
   for (std::uint32_t t = 0; t < n; ++t)
-    for (std::uint32_t u : topo.neighbors[t])
-      if (u != kNoTriangle && t < u && region[t] == region[u] && feature(t, u)) s.forbidden_pairs.push_back({t, u});
+    for (std::uint32_t u : topo.neighbors[t]) {
+      if (u == kNoTriangle || t > u || s.region[u] != s.region[t]) continue;
+      if (region[t] != region[u]) {
+        ++features;
+      } else if (!joined[t] && !joined[u] && is_feature(t, u)) {
+        ++features;
+        creases.push_back({t, u});
+      }
+    }
+  if (features == 0) return 0;
+  s.forbidden_pairs.insert(s.forbidden_pairs.end(), creases.begin(), creases.end());
   s.region = std::move(region);
   s.region_entity = std::move(entity);
   return features;

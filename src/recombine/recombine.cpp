@@ -294,8 +294,12 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
   if (!s.odd_regions_left.empty())
     result.warnings.push_back(fmt::format(
         "{} connected piece(s) have an odd number of triangles and no boundary edge to split: "
-        "at least one triangle will remain in each",
-        s.odd_regions_left.size()));
+        "at least one triangle will remain in each{}",
+        s.odd_regions_left.size(),
+        stats.feature_edges > 0 ? fmt::format(" (the {} feature edges cut the surface into {} pieces; a larger "
+                                              "feature angle cuts fewer)",
+                                              stats.feature_edges, s.region_entity.size())
+                                : std::string()));
   timer.stage("input", fmt::format("{} triangles, {} regions, {} feature edges", stats.input_triangles,
                                    s.region_entity.size(), stats.feature_edges));
 

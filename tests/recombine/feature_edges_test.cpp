@@ -185,6 +185,13 @@ TEST(FeatureEdges, SingleTrianglePiecesJoinANeighbour) {
   EXPECT_EQ(r.stats.odd_splits, 0u);
   EXPECT_EQ(r.stats.quads, 2u);
   EXPECT_EQ(r.stats.triangles, 0u);
+  // An octahedron: its faces join in pairs (or more), each piece even: four quads.
+  const Mesh octahedron = make_triangle_mesh_3d(
+      {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}},
+      {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}});
+  const RecombineResult o = recombine(octahedron, {});
+  EXPECT_EQ(o.stats.quads, 4u);
+  EXPECT_EQ(o.stats.triangles, 0u);
 }
 
 // An icosphere of radius 1 (icosahedron, each triangle cut in 4 `levels` times, the new
