@@ -313,6 +313,10 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
                      options.extra_edge_cost, &s.forbidden_pairs,
                      s.topology ? &*s.topology : nullptr};
   const DualGraph graph = build_dual_graph(gin);
+  // Surfaces in 3D: the input triangles, which the moved and added nodes are kept on (made
+  // while the kept topology is still there).
+  std::optional<SurfaceProjection> surface;
+  if (!s.planar && (options.optimize || options.full_quad)) surface.emplace(s);
   s.topology.reset();  // not needed below
   stats.graph_pairs = graph.num_real;
   stats.extra_pairs = graph.pairs.size() - graph.num_real;
@@ -350,9 +354,6 @@ RecombineResult recombine(const Mesh& input, const RecombineOptions& options) {
                                     "duplications", extra.size(), repaired.edge_swaps,
                                     repaired.vertex_duplications));
 
-  // Surfaces in 3D: the input triangles, which the moved and added nodes are kept on.
-  std::optional<SurfaceProjection> surface;
-  if (!s.planar && (options.optimize || options.full_quad)) surface.emplace(s);
   if (options.optimize) optimize(m, s, surface ? &*surface : nullptr, options, stats, timer);
   if (options.full_quad) {
     const std::vector<double> before = surface ? m.coords : std::vector<double>{};

@@ -333,7 +333,10 @@ void make_regions_even(TriangleSurface& s) {
   for (std::int32_t r : s.region) ++count[static_cast<std::size_t>(r)];
   std::vector<char> odd(num_regions, 0);
   bool any_odd = false;
-  for (std::size_t r = 0; r < num_regions; ++r) any_odd |= (odd[r] = count[r] % 2 == 1) != 0;
+  for (std::size_t r = 0; r < num_regions; ++r) {
+    odd[r] = count[r] % 2 == 1;
+    any_odd = any_odd || odd[r];
+  }
   if (!any_odd) return;
 
   std::optional<TriangleTopology> built;
