@@ -23,7 +23,7 @@ struct ConvertOptions {
 };
 
 int run_convert(const ConvertOptions& o) {
-  const MeshFormat out_format = format_from_extension(o.output);  // fails before reading
+  const MeshFormat out_format = output_format_from_extension(o.output);  // fails before reading
   const Mesh mesh = read_mesh(o.input);
   WriteOptions w;
   w.format = out_format;
@@ -43,11 +43,12 @@ void add_convert_command(CLI::App& app, int& exit_code) {
       "convert",
       "Convert a mesh between formats, chosen by extension.\n"
       "Reads .msh (Gmsh MSH 2.2 or 4.1, ASCII or binary), .stl (ASCII or binary), .obj, .off.\n"
-      "Writes .msh (MSH 4.1 ASCII unless --msh-version / --binary say otherwise) or .vtu\n"
-      "(VTK XML for ParaView, Lagrange cells for curved elements).\n"
+      "Writes .msh (MSH 4.1 ASCII unless --msh-version / --binary say otherwise), .vtu\n"
+      "(VTK XML for ParaView, Lagrange cells for curved elements), or .obj / .off (the\n"
+      "triangles and quadrangles as faces; curved ones by their corners).\n"
       "Exit status: 0 done, 2 bad input (the message names the file and line or byte offset).");
   cmd->add_option("input", options->input, "Mesh to read (.msh, .stl, .obj, .off)")->required();
-  cmd->add_option("output", options->output, "Mesh to write (.msh or .vtu); written to a temporary file, then renamed")
+  cmd->add_option("output", options->output, "Mesh to write (.msh, .vtu, .obj, .off); written to a temporary file, then renamed")
       ->required();
   cmd->add_option("--msh-version", options->msh_version, "MSH version of a .msh output")
       ->check(CLI::IsMember({"2.2", "4.1"}))

@@ -13,6 +13,7 @@
 #include "geometry_pipeline.hpp"
 #include "quadval/error.hpp"
 #include "quadval/geometry.hpp"
+#include "quadval/io.hpp"
 #include "quadval/planar_domain.hpp"
 
 namespace quadval::cli {
@@ -31,6 +32,8 @@ int run(const MeshCliOptions& o) {
     throw InputError::in_file("quadval mesh",
                               "give exactly one of GEOMETRY (a .geo, .step, .stp, .brep, .stl or "
                               "planar-domain .txt file) and --domain \"outer ...; hole ...\"");
+  output_format_from_extension(o.output);  // a bad output name fails before the meshing
+  if (!o.triangles_output.empty()) output_format_from_extension(o.triangles_output);
   TriangulationOptions t;
   t.algorithm = o.triangles == "frontal" ? TriangleAlgorithm::frontal
                 : o.triangles == "delaunay" ? TriangleAlgorithm::delaunay
@@ -94,7 +97,7 @@ void add_mesh_command(CLI::App& app, int& exit_code) {
                   "0 1 1', 'hole circle 0.5 0.5 0.1', ...)");
   cmd->add_option("--domain", o->domain,
                   "Planar domain on the command line, statements separated by ';'");
-  cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu), element field 'eta'")
+  cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu, with the element field 'eta'; or .obj, .off)")
       ->required();
   cmd->add_option("--size", o->size,
                   "Size field h(x,y,z), e.g. \"0.1 + 0.08*sin(3*x)*cos(6*y)\" (variables x y z; "
@@ -112,7 +115,7 @@ void add_mesh_command(CLI::App& app, int& exit_code) {
       ->check(CLI::IsMember({"blossom", "lookahead", "greedy", "none"}))
       ->capture_default_str();
   cmd->add_option("--triangles-output", o->triangles_output,
-                  "Also write the triangles (.msh or .vtu)");
+                  "Also write the triangles (.msh, .vtu, .obj or .off)");
   cmd->add_option("--pictures", o->pictures,
                   "Directory for SVG pictures: mesh coloured by eta, histograms of eta and l^h");
   cmd->add_option("--report", o->report, "Write the statistics as JSON to this file");

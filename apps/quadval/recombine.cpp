@@ -96,6 +96,7 @@ nlohmann::json stats_json(const RecombineStats& s) {
 
 int run(const RecombineCliOptions& o) {
   const auto start = std::chrono::steady_clock::now();
+  const MeshFormat out_format = output_format_from_extension(o.output);  // fails before the work
   TerminalProgress progress(!o.quiet);
   auto log = [&](const std::string& line) {
     progress.end_line();
@@ -146,7 +147,7 @@ int run(const RecombineCliOptions& o) {
 
   const auto write_start = std::chrono::steady_clock::now();
   const ElementField eta{"eta", element_eta(result.mesh, -1.0)};  // triangles (none when all-quad): -1
-  write_mesh(result.mesh, o.output, WriteOptions{format_from_extension(o.output), o.binary},
+  write_mesh(result.mesh, o.output, WriteOptions{out_format, o.binary},
              std::span<const ElementField>(&eta, 1));
   const double write_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
@@ -214,7 +215,7 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
       "recombine",
       "Recombine a triangle mesh into quadrangles (Blossom-Quad: optimal, all-quad)");
   cmd->add_option("input", o->input, "Triangle mesh (.msh, .stl, .obj, .off)")->required();
-  cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu); element field 'eta'")
+  cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu, with the element field 'eta'; or .obj, .off)")
       ->required();
   cmd->add_option("--algo", o->algo, "blossom (optimal, all-quad), lookahead (look-ahead tree, see --horizon: linear time, "
                   "near-optimal, quad-dominant) or greedy (quad-dominant)")

@@ -1,6 +1,6 @@
 #pragma once
 /// Mesh input and output: Gmsh MSH 2.2 and 4.1 (ASCII and binary) read and write, VTU
-/// (VTK XML) write, STL / OBJ / OFF surface read.
+/// (VTK XML) write, OBJ / OFF surface read and write, STL read.
 ///
 /// How files map onto a Mesh (mesh.hpp), so that read-write-read round trips are exact:
 ///
@@ -49,6 +49,13 @@
 /// with 3 vertices become Triangle 3, with 4 Quadrilateral 4, each in one block on entity
 /// (2, 1); node and element tags are 1..n in file order; entities and node_blocks are empty.
 ///
+/// Surfaces (OBJ, OFF write): the triangles and quadrangles, block after block, as faces
+/// over the nodes they use, in node order (coordinates in their shortest round-trip form, so
+/// reading the file back gives the same positions and faces). Higher-order faces keep their
+/// corners, point and line elements are left out (a warning each); a mesh with 3D elements
+/// or without faces is refused (InputError). Tags, entities and fields are not written.
+/// STL is not written: it holds triangles only.
+///
 /// Every error in the input raises InputError naming the file and the line (text) or byte
 /// offset (binary) and what was expected. Every output goes through write_file_atomically.
 
@@ -79,6 +86,10 @@ struct WriteOptions {
 /// Throws InputError for an unknown one.
 MeshFormat format_from_extension(const std::filesystem::path& path);
 
+/// The format to write `path` in (format_from_extension), checked before any work: throws
+/// InputError for an unknown extension and for .stl (read only).
+MeshFormat output_format_from_extension(const std::filesystem::path& path);
+
 /// Reads any supported input: MSH (version 2.2 or 4.1, ASCII or binary, detected from
 /// $MeshFormat), STL, OBJ, OFF (chosen by extension). Warnings (skipped sections...) are
 /// appended to *warnings when given, else printed to stderr with the file name.
@@ -86,8 +97,8 @@ MeshFormat format_from_extension(const std::filesystem::path& path);
 Mesh read_mesh(const std::filesystem::path& path, std::vector<std::string>* warnings = nullptr);
 
 /// Writes `mesh` to `path` atomically (write_file_atomically) in options.format (msh22,
-/// msh41 or vtu; the surface formats are input-only and throw InputError).
-/// Fields become $ElementData (MSH) or CellData (VTU).
+/// msh41, vtu, obj or off; stl throws InputError). Fields become $ElementData (MSH) or
+/// CellData (VTU); OBJ and OFF have no place for them.
 /// @pre each field has mesh.num_elements() values (throws std::invalid_argument otherwise)
 void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
                 const WriteOptions& options = {}, std::span<const ElementField> fields = {});

@@ -10,12 +10,17 @@
 #include "io/msh_reader.hpp"
 #include "io/msh_write.hpp"
 #include "io/surface_read.hpp"
+#include "io/surface_write.hpp"
 #include "io/vtu_write.hpp"
 #include "quadval/atomic_file.hpp"
 #include "quadval/error.hpp"
 #include "quadval/io.hpp"
 
 namespace quadval {
+
+namespace {
+constexpr const char* kStlReadOnly = "STL is read only (it holds triangles only); write .msh, .vtu, .obj or .off";
+}  // namespace
 
 MeshFormat format_from_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
@@ -27,6 +32,13 @@ MeshFormat format_from_extension(const std::filesystem::path& path) {
   if (ext == ".off") return MeshFormat::off;
   throw InputError::in_file(path.string(),
                             fmt::format("unknown extension '{}', expected .msh, .vtu, .stl, .obj or .off", ext));
+}
+
+MeshFormat output_format_from_extension(const std::filesystem::path& path) {
+  const MeshFormat format = format_from_extension(path);
+  if (format == MeshFormat::stl)
+    throw InputError::in_file(path.string(), kStlReadOnly);
+  return format;
 }
 
 Mesh read_mesh(const std::filesystem::path& path, std::vector<std::string>* warnings) {
@@ -70,9 +82,16 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const Write
     case MeshFormat::vtu:
       write_file_atomically(path, [&](std::ostream& out) { io::write_vtu(mesh, out, fields, name); });
       return;
-    default:
-      throw InputError::in_file(name, "STL, OBJ and OFF are input formats only; write .msh or .vtu");
+    case MeshFormat::obj:
+      write_file_atomically(path, [&](std::ostream& out) { io::write_obj(mesh, out, name); });
+      return;
+    case MeshFormat::off:
+      write_file_atomically(path, [&](std::ostream& out) { io::write_off(mesh, out, name); });
+      return;
+    case MeshFormat::stl:
+      break;
   }
+  throw InputError::in_file(name, kStlReadOnly);
 }
 
 }  // namespace quadval

@@ -8,6 +8,7 @@ list(APPEND QUADVAL_SOURCES
   src/io/msh_write.cpp
   src/io/parallel_lines.cpp
   src/io/surface_read.cpp
+  src/io/surface_write.cpp
   src/io/vtk_node_order.cpp
   src/io/vtu_write.cpp
   src/io/svg_common.cpp

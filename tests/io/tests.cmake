@@ -9,6 +9,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   io/parallel_lines_test.cpp
   io/parallel_lines22_test.cpp
   io/surface_read_test.cpp
+  io/surface_write_test.cpp
   io/vtu_write_test.cpp
   io/svg_test.cpp
 )

@@ -11,6 +11,9 @@
       VTK's own parametric coordinate of the point (cell.GetParametricCoords()) mapped onto
       Gmsh's reference element of the family. CellData "element_tag" must equal "tag" and
       "twice_tag" twice that. Prints each failure; exit 0 if none, 1 otherwise, 77 without vtk.
+  vtk_check.py obj FILE.obj OUT.json
+      Reads FILE.obj with vtkOBJReader and writes {"points": [[x, y, z], ...], "polygons":
+      [[i, ...], ...]} (0-based) as VTK sees them, for quadval's OBJ output (exit 77 without vtk).
 """
 import json
 import sys
@@ -106,8 +109,29 @@ def check(vtu, expect_file):
     sys.exit(1 if failures else 0)
 
 
+def obj(path, out):
+    try:
+        import vtk
+    except ImportError as e:
+        print(f"vtk Python module not available: {e}", file=sys.stderr)
+        sys.exit(77)
+    r = vtk.vtkOBJReader()
+    r.SetFileName(path)
+    r.Update()
+    data = r.GetOutput()
+    points = [list(data.GetPoint(i)) for i in range(data.GetNumberOfPoints())]
+    polygons = []
+    for c in range(data.GetNumberOfCells()):
+        ids = data.GetCell(c).GetPointIds()
+        polygons.append([ids.GetId(k) for k in range(ids.GetNumberOfIds())])
+    with open(out, "w") as f:
+        json.dump({"points": points, "polygons": polygons}, f)
+
+
 if __name__ == "__main__":
     if sys.argv[1] == "refs":
         gmsh_refs(sys.argv[2])
+    elif sys.argv[1] == "obj":
+        obj(sys.argv[2], sys.argv[3])
     else:
         check(sys.argv[2], sys.argv[3])

@@ -152,5 +152,35 @@ TEST_F(RecombineCli, FeatureAngleOfAnStlCube) {
   EXPECT_NE(bad.output.find("--feature-angle"), std::string::npos) << bad.output;
 }
 
+// OBJ in, OBJ out: the quads as faces, as many as the report counts; an STL output is
+// refused before any work, and nothing is written.
+TEST_F(RecombineCli, ObjInObjOutAndStlOutRefused) {
+  const fs::path in = dir_ / "strip.obj", out = dir_ / "q.obj", report = dir_ / "r.json";
+  {
+    std::ofstream f(in);  // a 6 x 4 grid of squares, each cut into two triangles
+    for (int j = 0; j <= 4; ++j)
+      for (int i = 0; i <= 6; ++i) f << "v " << i << " " << j << " 0\n";
+    for (int j = 0; j < 4; ++j)
+      for (int i = 0; i < 6; ++i) {
+        const int v = j * 7 + i + 1;
+        f << "f " << v << " " << v + 1 << " " << v + 8 << "\nf " << v << " " << v + 8 << " " << v + 7 << "\n";
+      }
+  }
+  const CliRun r = run_cli("recombine " + in.string() + " -o " + out.string() + " -q --report " + report.string());
+  ASSERT_EQ(r.code, 0) << r.output;
+  const Mesh q = read_mesh(out);
+  ASSERT_EQ(q.blocks.size(), 1u);
+  EXPECT_EQ(q.blocks[0].type->gmsh_id, 3);
+  std::ifstream f(report);
+  EXPECT_EQ(q.blocks[0].size(), nlohmann::json::parse(f).at("statistics").at("quads").get<std::size_t>());
+  EXPECT_GE(q.blocks[0].size(), 24u);
+
+  const CliRun stl = run_cli("recombine " + in.string() + " -o " + (dir_ / "q.stl").string());
+  EXPECT_EQ(stl.code, 2);
+  EXPECT_NE(stl.err.find("q.stl: STL is read only"), std::string::npos) << stl.output;
+  EXPECT_EQ(stl.err.find("[read]"), std::string::npos) << "refused only after reading: " << stl.output;
+  EXPECT_FALSE(fs::exists(dir_ / "q.stl"));
+}
+
 }  // namespace
 }  // namespace quadval
