@@ -166,9 +166,9 @@ int run(const RecombineCliOptions& o) {
     if (s.has_tau) fmt::print("  efficiency index tau {:.1f}%\n", s.tau);
     if (options.algorithm == RecombineAlgorithm::lookahead) {
       fmt::print("  look-ahead: q {:.2f}, {:.2f}% of the triangles recombined, {} left before "
-                 "post-process, {} after (best of {} runs: run {})\n",
+                 "post-process ({} paired along paths), {} after (best of {} runs: run {})\n",
                  s.lookahead_quality, 100.0 * s.recombined_share, s.lookahead_triangles_left,
-                 s.triangles, s.lookahead_runs.size(), s.lookahead_best_run);
+                 s.lookahead_path_pairs, s.triangles, s.lookahead_runs.size(), s.lookahead_best_run);
       if (s.quality_percent_of_blossom >= 0)
         fmt::print("  Blossom q {:.2f}: look-ahead reaches {:.2f}%\n", s.blossom_quality,
                    s.quality_percent_of_blossom);
@@ -198,6 +198,7 @@ int run(const RecombineCliOptions& o) {
           {"seed", o.seed}, {"runs", runs}, {"best_run", s.lookahead_best_run},
           {"quality", s.lookahead_quality}, {"recombined_share", s.recombined_share},
           {"triangles_left_before_post_process", s.lookahead_triangles_left},
+          {"triangles_paired_along_paths", s.lookahead_path_pairs},
           {"triangles_left_after_post_process", s.triangles},
           {"blossom_quality", s.blossom_quality >= 0 ? nlohmann::json(s.blossom_quality) : nlohmann::json(nullptr)},
           {"quality_percent_of_blossom", s.quality_percent_of_blossom >= 0 ? nlohmann::json(s.quality_percent_of_blossom) : nlohmann::json(nullptr)}};
@@ -218,7 +219,8 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
   cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu, with the element field 'eta'; or .obj, .off)")
       ->required();
   cmd->add_option("--algo", o->algo, "blossom (optimal, all-quad), lookahead (look-ahead tree, see --horizon: linear time, "
-                  "near-optimal, quad-dominant) or greedy (quad-dominant)")
+                  "near-optimal; the triangles it leaves are then paired where a short path or a local re-pairing finds a "
+                  "partner) or greedy (quad-dominant)")
       ->check(CLI::IsMember({"blossom", "greedy", "lookahead"}))
       ->capture_default_str();
   cmd->add_option("--cost", o->cost, "Pair cost: angle (1 - eta, eq. 3) or crossfield (eq. 7)")

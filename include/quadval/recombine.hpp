@@ -135,6 +135,7 @@ struct RecombineStats {
   // RecombineAlgorithm::lookahead (Paper II).
   double lookahead_quality = 0.0;           ///< q = sum of eta of the merges (best run)
   std::size_t lookahead_triangles_left = 0; ///< before any post-process
+  std::size_t lookahead_path_pairs = 0;     ///< leftover triangles then paired along paths
   double recombined_share = 0.0;            ///< share of the triangles merged (best run)
   std::size_t lookahead_best_run = 0;
   std::vector<LookaheadRun> lookahead_runs; ///< every run, in run order

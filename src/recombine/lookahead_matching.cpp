@@ -4,6 +4,7 @@
 
 #include <fmt/core.h>
 
+#include "leftover_paths.hpp"
 #include "lookahead_tree.hpp"
 #include "quadval/error.hpp"
 
@@ -56,6 +57,8 @@ Matching lookahead_matching(const DualGraph& graph, const TriangleSurface& s,
   std::sort(m.pairs.begin(), m.pairs.end());
   for (std::uint32_t p : m.pairs) m.cost += graph.pairs[p].cost;
   m.perfect = 2 * m.pairs.size() == graph.num_triangles;
+  // The post-process of Paper II §6: the leftover triangles paired (leftover_paths.hpp).
+  stats.lookahead_path_pairs = pair_leftovers(graph, m);
   stats.lookahead_runs = best.runs;
   stats.lookahead_best_run = best.best_run;
   stats.lookahead_quality = best.best.run.quality;

@@ -18,6 +18,7 @@ list(APPEND QUADVAL_SOURCES
   src/recombine/lookahead_state.cpp
   src/recombine/lookahead_tree.cpp
   src/recombine/lookahead_matching.cpp
+  src/recombine/leftover_paths.cpp
   src/recombine/lookahead_parity.cpp
 )
 list(APPEND QUADVAL_SOURCES src/recombine/lemon_matching.cpp)

@@ -8,6 +8,7 @@ list(APPEND QUADVAL_TEST_SOURCES
   recombine/quad_cleanup_test.cpp
   recombine/node_order_test.cpp
   recombine/triangle_input_test.cpp
+  recombine/leftover_paths_test.cpp
   recombine/feature_edges_test.cpp
   recombine/recombine_test.cpp
   recombine/repair_test.cpp
