@@ -158,6 +158,70 @@ std::size_t paths(const DualGraph& g, std::vector<std::uint32_t>& mate, std::siz
   return paired;
 }
 
+// Alternating trees grown from all free triangles at once, breadth first (one sweep of the
+// graph per round): where two trees meet, the path from one root through the meeting pair
+// to the other is swapped, and both trees stop for the round, so the round's paths share no
+// triangle. For partners far apart, where a search from each free triangle would cover an
+// area each; the paths are the fewest pairs, not the cheapest. Rounds go on while one pairs.
+std::size_t trees_together(const DualGraph& g, std::vector<std::uint32_t>& mate, int max_rounds) {
+  const std::uint32_t n = g.num_triangles;
+  const auto other = [&](std::uint32_t p, std::uint32_t t) {
+    return g.pairs[p].t0 == t ? g.pairs[p].t1 : g.pairs[p].t0;
+  };
+  std::size_t paired = 0;
+  std::vector<std::uint32_t> tree(n), reached_by(n), queue;
+  std::vector<char> inner(n), done;  // per tree (its root): augmented this round
+  for (int round = 0; round < max_rounds; ++round) {
+    std::fill(tree.begin(), tree.end(), kUnmatched);
+    std::fill(inner.begin(), inner.end(), 0);
+    done.assign(n, 0);
+    queue.clear();
+    for (std::uint32_t t = 0; t < n; ++t)
+      if (mate[t] == kUnmatched) {
+        tree[t] = t;
+        queue.push_back(t);
+      }
+    // Swaps the path from x back to its root, x taking pair `gained` (as paths() does).
+    const auto swap_to_root = [&](std::uint32_t x, std::uint32_t gained) {
+      while (true) {
+        const std::uint32_t given_up = mate[x];
+        mate[x] = gained;
+        if (given_up == kUnmatched) return;
+        const std::uint32_t y = other(given_up, x);
+        gained = reached_by[y];
+        mate[y] = gained;
+        x = other(gained, y);
+      }
+    };
+    const std::size_t before = paired;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::uint32_t x = queue[head];
+      if (done[tree[x]]) continue;
+      for (std::uint32_t i = g.offsets[x]; i < g.offsets[x + 1] && !done[tree[x]]; ++i) {
+        const std::uint32_t p = g.incident[i];
+        if (g.pairs[p].kind != PairKind::real || p == mate[x]) continue;
+        const std::uint32_t y = other(p, x);
+        if (tree[y] == kUnmatched) {  // matched, in no tree yet: y inner, its mate outer
+          const std::uint32_t z = other(mate[y], y);
+          if (tree[z] != kUnmatched) continue;
+          tree[y] = tree[z] = tree[x];
+          inner[y] = 1;
+          reached_by[y] = p;
+          queue.push_back(z);
+        } else if (tree[y] != tree[x] && !done[tree[y]] && !inner[y]) {
+          // y is outer in another live tree (its root, or an inner's mate): meet.
+          done[tree[x]] = done[tree[y]] = 1;
+          swap_to_root(x, p);
+          swap_to_root(y, p);
+          paired += 2;
+        }
+      }
+    }
+    if (paired == before) break;
+  }
+  return paired;
+}
+
 // Per triangle: its pair in m, or kUnmatched.
 std::vector<std::uint32_t> mates_of(const DualGraph& g, const Matching& m) {
   std::vector<std::uint32_t> mate(g.num_triangles, kUnmatched);
@@ -192,9 +256,17 @@ std::size_t pair_in_neighbourhoods(const DualGraph& g, Matching& m, int radius) 
   return paired;
 }
 
+std::size_t pair_by_trees(const DualGraph& g, Matching& m, int max_rounds) {
+  std::vector<std::uint32_t> mate = mates_of(g, m);
+  const std::size_t paired = trees_together(g, mate, max_rounds);
+  if (paired > 0) set_matching(g, mate, m);
+  return paired;
+}
+
 std::size_t pair_leftovers(const DualGraph& g, Matching& m) {
   std::vector<std::uint32_t> mate = mates_of(g, m);
-  const std::size_t paired = paths(g, mate, 256) + neighbourhoods(g, mate, 4) + neighbourhoods(g, mate, 16);
+  const std::size_t paired = paths(g, mate, 256) + neighbourhoods(g, mate, 4) + neighbourhoods(g, mate, 16) +
+                             trees_together(g, mate, 32) + neighbourhoods(g, mate, 64);
   if (paired > 0) set_matching(g, mate, m);
   return paired;
 }

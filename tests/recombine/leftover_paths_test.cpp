@@ -80,7 +80,8 @@ void expect_consistent(const DualGraph& g, const Matching& before, const Matchin
 
 // A jittered grid whose cells are all cut along the same diagonal: every interior node has
 // 6 triangles, so the dual graph is bipartite; pairing each cell's two triangles is a
-// perfect matching. From random maximal matchings, the path search alone pairs everything.
+// perfect matching. From random maximal matchings, the path search alone pairs everything,
+// and so do the trees grown together.
 TEST(LeftoverPaths, PathsPairEveryTriangleOfABipartiteGraph) {
   const int nx = 14, ny = 9;
   std::mt19937 rng(4);
@@ -108,6 +109,10 @@ TEST(LeftoverPaths, PathsPairEveryTriangleOfABipartiteGraph) {
     const std::size_t paired = pair_along_paths(g, m, std::numeric_limits<std::size_t>::max());
     expect_consistent(g, start, m, paired);
     EXPECT_TRUE(m.perfect);
+    // The trees grown together reach a maximum matching too: here, a perfect one.
+    Matching t = start;
+    expect_consistent(g, start, t, pair_by_trees(g, t, 1000));
+    EXPECT_TRUE(t.perfect);
   }
   EXPECT_GT(with_leftovers, 20);  // the starts must leave triangles to pair
 }
@@ -179,8 +184,9 @@ TEST(LeftoverPaths, KeepAMatchingOnMeshesWithHoles) {
     const TriangleSurface s = prepare_triangles(mesh, "random", warnings);
     const DualGraph g = graph_of(s);
     const Matching start = random_maximal(g, seed);
-    Matching paths = start, all = start;
+    Matching paths = start, trees = start, all = start;
     expect_consistent(g, start, paths, pair_along_paths(g, paths, 256));
+    expect_consistent(g, start, trees, pair_by_trees(g, trees, 32));
     expect_consistent(g, start, all, pair_leftovers(g, all));
     EXPECT_GE(all.pairs.size(), paths.pairs.size());
   }
