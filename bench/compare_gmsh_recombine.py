@@ -24,6 +24,7 @@ other jobs share the machine.
     /usr/bin/python3 bench/compare_gmsh_recombine.py --quadval build/quadval
     /usr/bin/python3 bench/compare_gmsh_recombine.py --quadval build/quadval \
         --cases rect-sin-a6 uniform-10k-a6 square-hole-35k
+    /usr/bin/python3 bench/compare_gmsh_recombine.py --algo blossom lookahead   # both routes
 
 Cases: rect-sin-a6 (../shared/data/tri/rect-sin.geo), uniform-N-a6 (unit square, uniform size,
 about N triangles; N = 10k reproduces uniform-10k-a6.msh's 10,076), uniform-N-a5 (the same
@@ -122,14 +123,14 @@ def summarize(xyz, quads, tris):
             "degree4": d4, "dmin": dmin, "dmax": dmax}
 
 
-def run_quadval(exe, path, runs):
+def run_quadval(exe, path, runs, algo="blossom"):
     out = os.path.join(CACHE, "quadval_out.msh")
     report = os.path.join(CACHE, "quadval_report.json")
     times, cpu, rss = [], [], 0
     for _ in range(runs):
         t0 = time.perf_counter()
         r = subprocess.run(["/usr/bin/time", "-f", "%M %U %S", exe, "recombine", path, "-o", out,
-                            "--report", report, "-q"], capture_output=True, text=True)
+                            "--report", report, "-q", "--algo", algo], capture_output=True, text=True)
         times.append(time.perf_counter() - t0)
         if r.returncode != 0:
             sys.exit(f"quadval failed on {path}: {r.stderr}")
@@ -294,6 +295,8 @@ def main():
     ap.add_argument("--cases", nargs="*",
                     default=["rect-sin-a6", "uniform-10k-a6", "square-hole-35k", "uniform-100k-a6",
                              "uniform-1000k-a6"])
+    ap.add_argument("--algo", nargs="+", default=["blossom"],
+                    help="quadval's --algo, one row each (blossom, lookahead: its all-quad fast route)")
     ap.add_argument("--gmsh-max-triangles", type=int, default=40000,
                     help="skip Gmsh above this size (it needs ~170 s at 100k, hours at 1M)")
     args = ap.parse_args()
@@ -308,22 +311,24 @@ def main():
         path = triangle_mesh(name, build)
         _, _, t = read_with_gmsh(path)
         n = len(t)
-        rows = [("quadval", run_quadval(args.quadval, path, args.runs))]
+        rows = [("quadval" if algo == "blossom" else "q/" + algo[:6], run_quadval(args.quadval, path, args.runs, algo))
+                for algo in args.algo]
         if n <= args.gmsh_max_triangles:
             rows.append(("gmsh", run_gmsh(build, args.runs)))
         for tool, r in rows:
             per_tri = r["rss_mb"] * 2**20 / n if r["rss_mb"] == r["rss_mb"] else float("nan")
-            note = (f"recombine stage {r['recombine_seconds']:.3f} s" if tool == "quadval" else
+            note = (f"recombine stage {r['recombine_seconds']:.3f} s" if tool != "gmsh" else
                     f"recombine() only; its triangulation {r['triangulate_seconds']:.3f} s")
             print(f"{name:18} {tool:8} {n:9d} {r['quads']:8d} {r['triangles']:5d} "
                   f"{r['eta_min']:7.3f} {r['eta_mean']:8.3f} {r['degree4']:6.1f} {r['dmin']:4d} "
                   f"{r['dmax']:4d} {r['seconds']:8.3f} {r['cpu_seconds']:7.3f} {r['rss_mb']:7.1f} {per_tri:6.0f}  {note}",
                   flush=True)
-        if len(rows) == 2:
-            g, q = rows[1][1], rows[0][1]
-            print(f"{'':18} ratio gmsh recombine() / quadval end to end: wall "
-                  f"{g['seconds'] / q['seconds']:.1f}, CPU {g['cpu_seconds'] / q['cpu_seconds']:.1f}",
-                  flush=True)
+        if rows[-1][0] == "gmsh":
+            g = rows[-1][1]
+            for tool, q in rows[:-1]:
+                print(f"{'':18} ratio gmsh recombine() / {tool} end to end: wall "
+                      f"{g['seconds'] / q['seconds']:.1f}, CPU {g['cpu_seconds'] / q['cpu_seconds']:.1f}",
+                      flush=True)
     gmsh.finalize()
 
 
