@@ -9,6 +9,11 @@ namespace quadval::recombine_detail {
 
 namespace {
 
+// The triangle of pair p that is not t.
+std::uint32_t other_triangle(const DualGraph& g, std::uint32_t p, std::uint32_t t) {
+  return g.pairs[p].t0 == t ? g.pairs[p].t1 : g.pairs[p].t0;
+}
+
 // A search step: an "outer" triangle to expand (pair == kUnmatched), or the end of a path,
 // from outer triangle `triangle` by pair `pair` to a free one. Cheapest first, then oldest.
 struct Step {
@@ -18,16 +23,77 @@ struct Step {
   bool operator>(const Step& o) const { return cost != o.cost ? cost > o.cost : order > o.order; }
 };
 
+// From each free triangle in increasing index, a best-first search for the cheapest
+// augmenting path (pairs gained minus pairs given up), labelling each triangle once and
+// stopping after max_visits triangles; the path found is swapped at once.
+std::size_t paths(const DualGraph& g, std::vector<std::uint32_t>& mate, std::size_t max_visits) {
+  const std::uint32_t n = g.num_triangles;
+  const auto other = [&](std::uint32_t p, std::uint32_t t) { return other_triangle(g, p, t); };
+  // Per triangle: the search that labelled it, and for an "inner" one (reached by a pair not
+  // in the matching, its mate then "outer") that pair.
+  std::vector<std::uint32_t> labelled(n, 0), reached_by(n, kUnmatched);
+  std::uint32_t search = 0;
+  std::size_t paired = 0;
+  for (std::uint32_t root = 0; root < n; ++root) {
+    if (mate[root] != kUnmatched) continue;
+    ++search;
+    labelled[root] = search;
+    std::priority_queue<Step, std::vector<Step>, std::greater<>> queue;
+    std::uint64_t order = 0;
+    queue.push({0.0, order++, root, kUnmatched});
+    std::size_t visits = 0;
+    while (!queue.empty()) {
+      const Step s = queue.top();
+      queue.pop();
+      if (s.pair != kUnmatched) {
+        // Swap along the path: s.pair joins s.triangle to the free end; back to the root, each
+        // outer triangle's pair is given up for the pair that reached its inner partner.
+        std::uint32_t x = s.triangle, gained = s.pair;
+        mate[other(gained, x)] = gained;
+        while (true) {
+          const std::uint32_t given_up = mate[x];
+          mate[x] = gained;
+          if (x == root) break;
+          const std::uint32_t y = other(given_up, x);
+          gained = reached_by[y];
+          mate[y] = gained;
+          x = other(gained, y);
+        }
+        paired += 2;
+        break;
+      }
+      if (++visits > max_visits) break;
+      const std::uint32_t x = s.triangle;
+      for (std::uint32_t i = g.offsets[x]; i < g.offsets[x + 1]; ++i) {
+        const std::uint32_t p = g.incident[i];
+        if (g.pairs[p].kind != PairKind::real || p == mate[x]) continue;
+        const std::uint32_t y = other(p, x);
+        if (labelled[y] == search) continue;
+        const double cost = s.cost + g.pairs[p].cost;
+        if (mate[y] == kUnmatched) {
+          queue.push({cost, order++, x, p});
+          continue;
+        }
+        const std::uint32_t z = other(mate[y], y);
+        if (labelled[z] == search) continue;
+        labelled[y] = labelled[z] = search;
+        reached_by[y] = p;
+        queue.push({cost - g.pairs[mate[y]].cost, order++, z, kUnmatched});
+      }
+    }
+  }
+  return paired;
+}
+
 // The free triangles' neighbourhoods (within `radius` pairs, plus the partners of the paired
 // triangles reached), each connected piece re-paired by an exact minimum-cost perfect
 // matching of its real pairs where one exists; a piece without one keeps its pairs. The
-// alternating search above cannot go through an odd cycle of pairs (a blossom); this can.
+// alternating searches (paths() above, trees_together() below) cannot go through an odd
+// cycle of pairs (a blossom); this can.
 // Returns the number of triangles paired.
 std::size_t neighbourhoods(const DualGraph& g, std::vector<std::uint32_t>& mate, int radius) {
   const std::uint32_t n = g.num_triangles;
-  const auto other = [&](std::uint32_t p, std::uint32_t t) {
-    return g.pairs[p].t0 == t ? g.pairs[p].t1 : g.pairs[p].t0;
-  };
+  const auto other = [&](std::uint32_t p, std::uint32_t t) { return other_triangle(g, p, t); };
   const auto usable = [&](std::uint32_t p) { return g.pairs[p].kind == PairKind::real; };
   std::vector<int> depth(n, -1);
   std::vector<std::uint32_t> queue;
@@ -97,67 +163,6 @@ std::size_t neighbourhoods(const DualGraph& g, std::vector<std::uint32_t>& mate,
   return paired;
 }
 
-std::size_t paths(const DualGraph& g, std::vector<std::uint32_t>& mate, std::size_t max_visits) {
-  const std::uint32_t n = g.num_triangles;
-  const auto other = [&](std::uint32_t p, std::uint32_t t) {
-    return g.pairs[p].t0 == t ? g.pairs[p].t1 : g.pairs[p].t0;
-  };
-  // Per triangle: the search that labelled it, and for an "inner" one (reached by a pair not
-  // in the matching, its mate then "outer") that pair.
-  std::vector<std::uint32_t> labelled(n, 0), reached_by(n, kUnmatched);
-  std::uint32_t search = 0;
-  std::size_t paired = 0;
-  for (std::uint32_t root = 0; root < n; ++root) {
-    if (mate[root] != kUnmatched) continue;
-    ++search;
-    labelled[root] = search;
-    std::priority_queue<Step, std::vector<Step>, std::greater<>> queue;
-    std::uint64_t order = 0;
-    queue.push({0.0, order++, root, kUnmatched});
-    std::size_t visits = 0;
-    while (!queue.empty()) {
-      const Step s = queue.top();
-      queue.pop();
-      if (s.pair != kUnmatched) {
-        // Swap along the path: s.pair joins s.triangle to the free end; back to the root, each
-        // outer triangle's pair is given up for the pair that reached its inner partner.
-        std::uint32_t x = s.triangle, gained = s.pair;
-        mate[other(gained, x)] = gained;
-        while (true) {
-          const std::uint32_t given_up = mate[x];
-          mate[x] = gained;
-          if (x == root) break;
-          const std::uint32_t y = other(given_up, x);
-          gained = reached_by[y];
-          mate[y] = gained;
-          x = other(gained, y);
-        }
-        paired += 2;
-        break;
-      }
-      if (++visits > max_visits) break;
-      const std::uint32_t x = s.triangle;
-      for (std::uint32_t i = g.offsets[x]; i < g.offsets[x + 1]; ++i) {
-        const std::uint32_t p = g.incident[i];
-        if (g.pairs[p].kind != PairKind::real || p == mate[x]) continue;
-        const std::uint32_t y = other(p, x);
-        if (labelled[y] == search) continue;
-        const double cost = s.cost + g.pairs[p].cost;
-        if (mate[y] == kUnmatched) {
-          queue.push({cost, order++, x, p});
-          continue;
-        }
-        const std::uint32_t z = other(mate[y], y);
-        if (labelled[z] == search) continue;
-        labelled[y] = labelled[z] = search;
-        reached_by[y] = p;
-        queue.push({cost - g.pairs[mate[y]].cost, order++, z, kUnmatched});
-      }
-    }
-  }
-  return paired;
-}
-
 // Alternating trees grown from all free triangles at once, breadth first (one sweep of the
 // graph per round): where two trees meet, the path from one root through the meeting pair
 // to the other is swapped, and both trees stop for the round, so the round's paths share no
@@ -165,9 +170,7 @@ std::size_t paths(const DualGraph& g, std::vector<std::uint32_t>& mate, std::siz
 // area each; the paths are the fewest pairs, not the cheapest. Rounds go on while one pairs.
 std::size_t trees_together(const DualGraph& g, std::vector<std::uint32_t>& mate, int max_rounds) {
   const std::uint32_t n = g.num_triangles;
-  const auto other = [&](std::uint32_t p, std::uint32_t t) {
-    return g.pairs[p].t0 == t ? g.pairs[p].t1 : g.pairs[p].t0;
-  };
+  const auto other = [&](std::uint32_t p, std::uint32_t t) { return other_triangle(g, p, t); };
   std::size_t paired = 0;
   std::vector<std::uint32_t> tree(n), reached_by(n), queue;
   std::vector<char> inner(n), done;  // per tree (its root): augmented this round
