@@ -82,8 +82,9 @@ struct RecombineOptions {
   /// Optional size field: weights the smoothing (so that it keeps the gradation) and gives the
   /// efficiency index tau of eq. (1)-(2) in the statistics.
   SizeFunction size_field;
-  /// RecombineAlgorithm::lookahead: tree, horizon, seed, runs. Leftover triangles become
-  /// quads with full_quad (the documented all-quad post-process: Fig. 2 refinement).
+  /// RecombineAlgorithm::lookahead: tree, horizon, seed, runs. The triangles the tree leaves
+  /// are then paired along augmenting paths (Paper II §6's post-process; all-quad on every
+  /// benchmark mesh); any still left become quads with full_quad (Fig. 2 refinement).
   LookaheadOptions lookahead;
   /// lookahead: also solve Blossom on the same pairs, for quality_percent_of_blossom.
   bool compare_with_blossom = false;
