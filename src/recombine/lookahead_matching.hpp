@@ -13,8 +13,9 @@ namespace quadval::recombine_detail {
 
 /// Best of options.lookahead.runs runs on the real pairs of `graph` (built without extra
 /// pairs), then its leftover triangles paired (leftover_paths.hpp: lookahead_path_pairs).
-/// Fills the lookahead_* statistics (the tree's own: quality, triangles left); with options.compare_with_blossom also the
-/// Blossom optimum on the same pairs (blossom_matching) and the percentage.
+/// Fills the lookahead_* statistics (the tree's own: quality, triangles left); with
+/// options.compare_with_blossom also the Blossom optimum on the same pairs
+/// (blossom_matching) and the percentage.
 /// @throws InputError (naming options.source) when a connected set of triangles has an odd
 ///         count: the criterion needs even polder sets. OddPolicy::split_boundary_edge
 ///         (make_pieces_even) fixes every odd piece that has a boundary edge; this is left for
