@@ -219,8 +219,8 @@ void add_recombine_command(CLI::App& app, int& exit_code) {
   cmd->add_option("-o,--output", o->output, "Output mesh (.msh or .vtu, with the element field 'eta'; or .obj, .off)")
       ->required();
   cmd->add_option("--algo", o->algo, "blossom (optimal, all-quad), lookahead (look-ahead tree, see --horizon: linear time, "
-                  "near-optimal; the triangles it leaves are then paired where a short path or a local re-pairing finds a "
-                  "partner) or greedy (quad-dominant)")
+                  "near-optimal; the triangles it leaves are then paired along augmenting paths: all-quad on the benchmark "
+                  "meshes) or greedy (quad-dominant)")
       ->check(CLI::IsMember({"blossom", "greedy", "lookahead"}))
       ->capture_default_str();
   cmd->add_option("--cost", o->cost, "Pair cost: angle (1 - eta, eq. 3) or crossfield (eq. 7)")

@@ -52,8 +52,9 @@
 /// Surfaces (OBJ, OFF write): the triangles and quadrangles, block after block, as faces
 /// over the nodes they use, in node order (coordinates in their shortest round-trip form, so
 /// reading the file back gives the same positions and faces). Higher-order faces keep their
-/// corners, point and line elements are left out (a warning each); a mesh with 3D elements
-/// or without faces is refused (InputError). Tags, entities and fields are not written.
+/// corners and point and line elements are left out, with one warning for each of the two;
+/// a mesh with 3D elements or without faces is refused (InputError). Tags, entities and
+/// fields are not written.
 /// STL is not written: it holds triangles only.
 ///
 /// Every error in the input raises InputError naming the file and the line (text) or byte
