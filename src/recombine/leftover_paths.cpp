@@ -268,8 +268,8 @@ std::size_t pair_by_trees(const DualGraph& g, Matching& m, int max_rounds) {
 
 std::size_t pair_leftovers(const DualGraph& g, Matching& m) {
   std::vector<std::uint32_t> mate = mates_of(g, m);
-  const std::size_t paired = paths(g, mate, 256) + neighbourhoods(g, mate, 4) + neighbourhoods(g, mate, 16) +
-                             trees_together(g, mate, 32) + neighbourhoods(g, mate, 64);
+  const std::size_t paired = paths(g, mate, 256) + neighbourhoods(g, mate, 4) + trees_together(g, mate, 32) +
+                             neighbourhoods(g, mate, 16) + neighbourhoods(g, mate, 64);
   if (paired > 0) set_matching(g, mate, m);
   return paired;
 }

@@ -7,20 +7,22 @@
 // unpaired. In turn:
 // 1. from each free triangle, the cheapest path that a best-first search finds (the cost of
 //    the pairs gained minus that of the pairs given up) within 256 triangles;
-// 2. for those still free, an exact re-pairing of their neighbourhoods (within 4, then 16
-//    pairs): each connected piece gets the minimum-cost perfect matching of its real pairs
+// 2. for those still free, an exact re-pairing of their neighbourhoods within 4 pairs: each
+//    connected piece gets the minimum-cost perfect matching of its real pairs
 //    (blossom_solver.hpp) where one exists; this also passes odd cycles of pairs, where an
 //    alternating search cannot;
 // 3. for partners far apart, alternating trees grown from all free triangles at once, a
-//    sweep of the graph per round: the shortest paths where the trees meet (fewest pairs,
-//    not the cheapest);
-// 4. step 2 again within 64 pairs, for the odd cycles step 3 cannot pass.
+//    sweep of the graph per round (at most 32): the shortest paths where the trees meet
+//    (fewest pairs, not the cheapest);
+// 4. step 2 again within 16, then 64 pairs, for the odd cycles step 3 cannot pass.
+// Step 2 within 16 pairs before step 3 took 1.2 s on uniform-1000k-a6 for 36 triangles
+// (neighbourhoods in regions of equal costs are slow to solve, as Blossom is there); after
+// it, 0.02 s.
 // Measured (`quadval recombine --algo lookahead`: triangles left before -> after, eta_min,
-// the look-ahead stage's time): uniform-100k-a6 408 -> 0, 0.481 -> 0.499, about 0.3 ->
-// 0.42 s (Blossom: 5.8 s, eta_min 0.553, cost 16,937 against 17,001 here);
-// square-hole-100k 364 -> 0, 0.501 -> 0.502; square-hole-1000k 3,238 -> 0, 0.506 -> 0.475,
-// 3.2 -> 3.8 s; disk-20k-a5 52 -> 0; disk-50k-a5 76 -> 0, 0.436 -> 0.490; box-12k-a6
-// 132 -> 0, 0.538 -> 0.555.
+// end to end): all-quad on 21 of the 22 meshes of /tmp/quadval_recombine_bench and the STL
+// and CAD test surfaces; uniform-100k-a6 408 -> 0, 0.481 -> 0.526, 0.53 s (Blossom: about
+// 6 s, eta_min 0.553); square-hole-1000k 3,238 -> 0, 0.506 -> 0.513, 5.7 s;
+// uniform-1000k-a6 3,488 -> 86, 7.5 s (the post-process 2.2 s of it, 32 rounds of step 3).
 
 #include <cstddef>
 
